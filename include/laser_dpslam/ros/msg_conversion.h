@@ -1,0 +1,27 @@
+// Conversions between ROS messages and the core's types: the only unit that knows both.
+#pragma once
+
+#include <geometry_msgs/Pose.h>
+#include <geometry_msgs/Transform.h>
+#include <sensor_msgs/LaserScan.h>
+
+#include "laser_dpslam/laser_scan.h"
+#include "laser_dpslam/pose2d.h"
+
+namespace laser_dpslam {
+
+LaserScan fromMsg(const sensor_msgs::LaserScan& msg);
+sensor_msgs::LaserScan toMsg(const LaserScan& scan);
+
+/// Planar part of a 3D pose (yaw of the quaternion). `upside_down` is set when the z axis points down
+/// (roll or pitch near pi): an upside-down laser has its beam angles mirrored.
+Pose2D poseFromMsg(const geometry_msgs::Pose& msg, bool* upside_down = nullptr);
+Pose2D poseFromMsg(const geometry_msgs::Transform& msg, bool* upside_down = nullptr);
+
+geometry_msgs::Pose toPoseMsg(const Pose2D& pose);
+geometry_msgs::Transform toTransformMsg(const Pose2D& pose);
+
+/// tf2 rejects frame ids with a leading slash (old bags: "/laser"); strip it.
+std::string cleanFrameId(const std::string& frame_id);
+
+}  // namespace laser_dpslam

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# scripts/test.sh: set up and build, run every test (gtest + nosetests + rostest through catkin), print the
+# catkin summary, copy the JUnit XML to out/test_results/, exit non-zero on any failure.
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
+cd "$WS"
+rm -rf "$WS/build/test_results"
+status=0
+catkin_make run_tests -DPYTHON_EXECUTABLE=/usr/bin/python3 -j"$(nproc)" > "$WS/test.log" 2>&1 || status=$?
+grep -E "^\[ +(RUN|OK|FAILED|PASSED) +\]|^\[ROSTEST\]|^FAIL|^ERROR|^Ran |^OK$" "$WS/test.log" | grep -v "^\[ RUN" || true
+mkdir -p "$REPO/out/test_results"
+rm -rf "$REPO/out/test_results"/*
+cp -r "$WS/build/test_results/." "$REPO/out/test_results/" 2>/dev/null || true
+summary=0
+catkin_test_results "$WS/build/test_results" --verbose > "$WS/test_summary.log" 2>&1 || summary=$?
+grep -v "^Skipping" "$WS/test_summary.log" | tail -n 40
+if [[ $status -ne 0 ]]; then
+  echo "[laser_dpslam] catkin_make run_tests failed (exit $status); log: $WS/test.log" >&2
+  tail -n 40 "$WS/test.log" >&2
+  exit 1
+fi
+exit $summary
