@@ -18,7 +18,8 @@ struct ScanPreprocessorConfig {
   double angle_max = std::numeric_limits<double>::infinity();   ///< rad
 };
 
-/// What happened to each beam of one scan.
+/// What happened to each beam of one scan. For a well-formed scan every beam is counted exactly once:
+/// total = valid + nan + pos_inf + neg_inf + below_min + above_max + outside_window.
 struct BeamCounts {
   std::size_t total = 0;
   std::size_t valid = 0;
@@ -47,6 +48,8 @@ struct PreprocessedScan {
 /// Validates the scan's geometry (finite angles, non-zero increment consistent with angle_min/max,
 /// sane range limits, non-empty ranges) and converts every valid beam to a point. Never throws.
 /// A malformed scan comes back with `error` set and no points. Beam counts may change between calls.
+/// An invalid config (NaN limits, empty angle or range window) is reported through `error` too.
+/// Angles are compared with the config window as given (no wrapping): beam i is at angle_min + i·increment.
 PreprocessedScan preprocessScan(const LaserScan& scan, const ScanPreprocessorConfig& config);
 
 }  // namespace laser_dpslam

@@ -65,6 +65,17 @@ Pose2D poseFromMsg(const geometry_msgs::Transform& msg, bool* upside_down) {
   return planar(msg.translation.x, msg.translation.y, q, upside_down);
 }
 
+LaserMount mountFromTransform(const geometry_msgs::Transform& msg) {
+  tf2::Quaternion q(msg.rotation.x, msg.rotation.y, msg.rotation.z, msg.rotation.w);
+  if (q.length2() < 1e-12) q = tf2::Quaternion(0, 0, 0, 1);
+  q.normalize();
+  const tf2::Matrix3x3 m(q);
+  LaserMount mount;
+  mount.A << m[0][0], m[0][1], m[1][0], m[1][1];
+  mount.t = Eigen::Vector2d(msg.translation.x, msg.translation.y);
+  return mount;
+}
+
 geometry_msgs::Pose toPoseMsg(const Pose2D& pose) {
   geometry_msgs::Pose p;
   p.position.x = pose.x;

@@ -5,6 +5,7 @@
 #include <geometry_msgs/Transform.h>
 #include <sensor_msgs/LaserScan.h>
 
+#include "laser_dpslam/laser_mount.h"
 #include "laser_dpslam/laser_scan.h"
 #include "laser_dpslam/pose2d.h"
 
@@ -17,6 +18,9 @@ sensor_msgs::LaserScan toMsg(const LaserScan& scan);
 /// (roll or pitch near pi): an upside-down laser has its beam angles mirrored.
 Pose2D poseFromMsg(const geometry_msgs::Pose& msg, bool* upside_down = nullptr);
 Pose2D poseFromMsg(const geometry_msgs::Transform& msg, bool* upside_down = nullptr);
+
+/// The laser's mount from the 3D base→laser transform (handles upside-down lasers, see LaserMount).
+LaserMount mountFromTransform(const geometry_msgs::Transform& msg);
 
 geometry_msgs::Pose toPoseMsg(const Pose2D& pose);
 geometry_msgs::Transform toTransformMsg(const Pose2D& pose);

@@ -1,0 +1,85 @@
+// Laser odometry: every scan is matched (ScanMatcher) against a local map made of the last few
+// keyframes, starting from a constant-velocity prior, so the drift grows per keyframe, not per scan.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "laser_dpslam/laser_mount.h"
+#include "laser_dpslam/pose2d.h"
+#include "laser_dpslam/saliency_resampler.h"
+#include "laser_dpslam/scan_matcher.h"
+#include "laser_dpslam/scan_preprocessor.h"
+#include "laser_dpslam/scan_resampler.h"
+
+namespace laser_dpslam {
+
+struct LaserOdometryConfig {
+  ResamplingMethod resampling = ResamplingMethod::kSaliency;  ///< points used to match each scan
+  int resampling_budget = 100;       ///< points kept for the DE search
+  int polish_budget = 0;             ///< points (spatially uniform) for the Newton polish; 0 = all valid points
+  SaliencyConfig saliency;
+  ScanMatcherConfig matcher;
+  double keyframe_distance = 0.25;   ///< m moved since the last keyframe before a new one is taken
+  double keyframe_angle = 0.17;      ///< rad turned since the last keyframe before a new one is taken
+  int local_map_keyframes = 5;       ///< keyframes in the local map
+  double map_voxel = 0.05;           ///< m, voxel size of the local map's points
+  int min_points = 20;               ///< fewer valid points: the scan is skipped
+  double max_prior_gap = 1.0;        ///< s; a longer gap between scans gives a zero-velocity prior
+  std::uint64_t seed = 1;            ///< seed of the DE random generator
+};
+
+/// What one scan produced.
+struct OdometryUpdate {
+  bool ok = false;                    ///< false: the scan was skipped (see skip_reason); pose propagated
+  std::string skip_reason;            ///< "too_few_points", "time_backwards", "duplicate_stamp", "match_failed"
+  bool reset = false;                 ///< the odometry was reset (first scan, or time went backwards)
+  double stamp = 0.0;
+  Pose2D pose;                        ///< odom → base_link
+  Eigen::Matrix3d pose_covariance = Eigen::Matrix3d::Zero();
+  Pose2D delta;                       ///< motion since the previous scan, in the previous base frame
+  Eigen::Matrix3d delta_covariance = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< (vx, vy, ω) in the base frame
+  MatchResult match;
+  bool new_keyframe = false;
+  int points_used = 0;
+};
+
+class LaserOdometry {
+ public:
+  explicit LaserOdometry(const LaserOdometryConfig& config = LaserOdometryConfig());
+
+  /// Processes one preprocessed scan (laser frame) with the laser's mount on the robot.
+  OdometryUpdate process(const PreprocessedScan& scan, const LaserMount& mount);
+
+  /// Forgets everything (next scan starts at the identity).
+  void reset();
+
+  const Pose2D& pose() const { return pose_; }
+  const LaserOdometryConfig& config() const { return config_; }
+  std::size_t keyframes() const { return keyframes_.size(); }
+
+ private:
+  struct Keyframe {
+    Pose2D pose;
+    std::vector<Eigen::Vector2d> points;  ///< in the odom frame
+  };
+  void addKeyframe(const std::vector<Eigen::Vector2d>& base_points);
+
+  LaserOdometryConfig config_;
+  ScanMatcher matcher_;
+  std::mt19937_64 rng_;
+  bool initialized_ = false;
+  double last_stamp_ = 0.0;
+  Pose2D pose_;
+  Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  ///< base frame, per second
+  std::deque<Keyframe> keyframes_;
+  std::uint64_t scan_count_ = 0;
+};
+
+}  // namespace laser_dpslam

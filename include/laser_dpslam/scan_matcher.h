@@ -1,0 +1,100 @@
+// Scan matching of a scan against a reference point set (a keyframe or a local map): NDT score
+// (Biber & Straßer) searched by Differential Evolution in a window around a motion prior, then polished
+// by Newton steps on the exact score, coarse to fine. Returns the pose, an honest covariance and the
+// thesis's quality figures.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "laser_dpslam/differential_evolution.h"
+#include "laser_dpslam/ndt_grid.h"
+#include "laser_dpslam/ndt_score_raster.h"
+#include "laser_dpslam/pose2d.h"
+
+namespace laser_dpslam {
+
+struct ScanMatcherConfig {
+  std::vector<double> cell_sizes{1.0, 0.5};  ///< m, NDT resolutions, coarse to fine; DE runs on the first
+  NdtGridConfig ndt;                         ///< cell_size is overwritten by each of cell_sizes
+  double raster_resolution = 0.05;           ///< m, sample spacing of the DE score raster
+
+  // Differential Evolution (algorithms.md §3).
+  bool use_de = true;                 ///< false: Newton from the prior only (for comparison)
+  int de_population = 20;             ///< NP
+  int de_generations = 30;            ///< G, upper bound
+  double de_F = 0.6;                  ///< scale factor
+  double de_CR = 0.9;                 ///< crossover rate
+  bool de_dither = true;              ///< F ~ U(0.5, 1) per generation
+  double window_xy = 0.3;             ///< m, half-width of the search window around the prior
+  double window_theta = 0.26;         ///< rad, half-width of the search window (≈ 15°)
+  double de_spread_xy = 0.01;         ///< m, stop when the population spread is below this …
+  double de_spread_theta = 0.005;     ///< rad, … and this
+  int de_stall_generations = 8;       ///< stop after this many generations without improvement
+
+  // Newton polish on h (algorithms.md §2).
+  int newton_iterations = 10;         ///< per resolution
+  double newton_tolerance = 1e-5;     ///< m / rad, step size at which Newton stops
+
+  // Covariance and quality.
+  double covariance_scale = 4.0;        ///< α in Σ = α·H⁻¹ + Σ_min (h is not a normalised likelihood)
+  double min_sigma_xy = 0.005;          ///< m, standard deviation floor
+  double min_sigma_theta = 0.002;       ///< rad, standard deviation floor
+  double degeneracy_ratio = 0.02;       ///< eigenvalue of H's translation block below this × its largest: degenerate
+  double degenerate_sigma = 0.3;        ///< m, σ added along a degenerate translation direction
+  double weak_score = 0.25;             ///< score per point (0…1) below which the match is weak
+  double weak_matched_fraction = 0.5;   ///< matched fraction below which the match is weak
+  double weak_inflation = 10.0;         ///< covariance multiplier for a weak match
+};
+
+struct MatchResult {
+  bool valid = false;                         ///< false: nothing to match against or no points
+  Pose2D pose;                                ///< pose of the scan's frame in the reference frame
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();  ///< of h at the optimum (finest resolution)
+  double score_per_point = 0.0;   ///< −h / (4·points) in [0, 1]: 1 = every point on a cell mean
+  double matched_fraction = 0.0;  ///< points within 3σ of a cell
+  bool degenerate = false;        ///< a direction is unconstrained (corridor, single wall)
+  bool weak = false;              ///< low score or low overlap
+  int de_generations = 0;
+  int de_evaluations = 0;
+  int newton_iterations = 0;
+};
+
+class ScanMatcher {
+ public:
+  explicit ScanMatcher(const ScanMatcherConfig& config = ScanMatcherConfig());
+
+  /// Builds the NDT grids and the DE raster of the reference (points in the reference frame).
+  void setReference(const std::vector<Eigen::Vector2d>& points);
+  bool hasReference() const;
+
+  /// Matches `points` (in the scan's own frame) starting from `prior`.
+  MatchResult match(const std::vector<Eigen::Vector2d>& points, const Pose2D& prior, std::mt19937_64& rng) const {
+    return match(points, points, prior, rng);
+  }
+
+  /// DE searches with `search_points` (a resampled subset: the cost is evaluated hundreds of times);
+  /// the Newton polish, the covariance and the quality use `polish_points` (more points: the precision
+  /// of the estimate grows with them, and Newton needs only a few evaluations).
+  MatchResult match(const std::vector<Eigen::Vector2d>& search_points, const std::vector<Eigen::Vector2d>& polish_points,
+                    const Pose2D& prior, std::mt19937_64& rng) const;
+
+  /// Newton polish only, from `start`, on resolution level `level` (exposed for tests).
+  Pose2D polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
+                int* iterations = nullptr) const;
+
+  const ScanMatcherConfig& config() const { return config_; }
+  const NdtGrid& grid(std::size_t level) const { return grids_.at(level); }
+
+ private:
+  Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, MatchResult& result) const;
+
+  ScanMatcherConfig config_;
+  std::vector<NdtGrid> grids_;
+  NdtScoreRaster raster_;
+};
+
+}  // namespace laser_dpslam

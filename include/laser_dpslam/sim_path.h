@@ -1,0 +1,70 @@
+// Timed robot trajectories through waypoints at iRobot Create speeds, for the laser simulator. No ROS.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "laser_dpslam/floor_plan.h"
+#include "laser_dpslam/pose2d.h"
+
+namespace laser_dpslam {
+
+/// Motion limits. Defaults suit an iRobot Create (its firmware allows 0.5 m/s; people drive it slower).
+struct PathConfig {
+  double cruise_speed = 0.3;           ///< m/s, forward speed on straight segments
+  double max_speed = 0.5;              ///< m/s, hard limit (cruise_speed must not exceed it)
+  double turn_rate = 1.0;              ///< rad/s, turn-in-place rate
+  double max_turn_rate = 1.5;          ///< rad/s, hard limit (turn_rate must not exceed it)
+  double linear_acceleration = 0.5;    ///< m/s², trapezoidal speed profile on each segment
+  double angular_acceleration = 2.0;   ///< rad/s², trapezoidal turn-rate profile on each turn
+  double start_pause = 0.0;            ///< s standing still at the first waypoint before moving
+  double end_pause = 0.0;              ///< s standing still at the last waypoint after arriving
+
+  /// Throws std::invalid_argument on non-positive or inconsistent limits.
+  void validate() const;
+};
+
+/// The robot's (base_link's) pose and velocity at one instant.
+struct TimedPose {
+  double stamp = 0.0;  ///< s from the start of the path
+  Pose2D pose;         ///< map-frame pose of base_link
+  double v = 0.0;      ///< m/s, forward speed (base_link x)
+  double w = 0.0;      ///< rad/s, turn rate (counter-clockwise positive)
+};
+
+/// Drives the waypoints (map frame, metres) in order: the robot starts at the first facing the second,
+/// and at each waypoint it stops and turns in place towards the next one (no turn after the last).
+/// Straight segments and turns use trapezoidal profiles (accelerate, cruise, decelerate to a stop).
+/// Consecutive duplicate waypoints are skipped. Samples at stamps k / rate_hz, k = 0, 1, …, up to and
+/// including the first sample at or after arrival (clamped to the final pose, so the last sample is
+/// exactly the last waypoint, standing still).
+/// Throws std::invalid_argument with fewer than two distinct waypoints or rate_hz ≤ 0.
+std::vector<TimedPose> samplePath(const std::vector<Eigen::Vector2d>& waypoints, double rate_hz,
+                                  const PathConfig& config = PathConfig());
+
+/// Total duration [s] of the path samplePath() would drive (from the start to arrival).
+double pathDuration(const std::vector<Eigen::Vector2d>& waypoints, const PathConfig& config = PathConfig());
+
+/// Reads a waypoint file: one `x y` per line (metres), `#` starts a comment, blank lines ignored.
+/// Throws std::runtime_error naming the file (and the line number for a malformed line), or when the
+/// file is missing or holds fewer than two waypoints.
+std::vector<Eigen::Vector2d> loadWaypoints(const std::string& path);
+
+/// Whether the path ends where it starts (within `tolerance` metres).
+bool isClosedLoop(const std::vector<Eigen::Vector2d>& waypoints, double tolerance = 1e-3);
+
+/// `laps` times around a loop: the waypoints repeated, closing the loop first if it is open.
+std::vector<Eigen::Vector2d> repeatLoop(const std::vector<Eigen::Vector2d>& loop, int laps);
+
+/// The built-in paths of a floor plan: `PLAN_DIR/<stem>_<name>.txt` next to PLAN.yaml (e.g.
+/// plans/office.yaml, "loop" → plans/office_loop.txt). Returns the path; does not check it exists.
+std::string builtinPathFile(const std::string& plan_yaml, const std::string& name);
+
+/// Checks that the robot (a disc of `robot_radius` metres) can drive the waypoints on the plan: every
+/// point along every segment has at least that much clearance from occupied cells. Returns an empty
+/// string when it can, else a message naming the first offending segment and point.
+std::string checkPathClearance(const FloorPlan& plan, const std::vector<Eigen::Vector2d>& waypoints,
+                               double robot_radius);
+
+}  // namespace laser_dpslam

@@ -1,0 +1,27 @@
+// TUM trajectory files (`stamp x y z qx qy qz qw`) and atomic file writing.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "laser_dpslam/pose2d.h"
+
+namespace laser_dpslam {
+
+struct StampedPose {
+  double stamp = 0.0;
+  Pose2D pose;
+};
+
+/// Writes `content` to `path` through a temporary file in the same directory and a rename, so a reader
+/// never sees a partial file and an existing file survives a failed write. Throws std::runtime_error
+/// naming the path (and errno's text) on failure.
+void writeFileAtomically(const std::string& path, const std::string& content);
+
+/// TUM text of a planar trajectory (z = 0, rotation about z), stamps with 9 decimals.
+std::string formatTum(const std::vector<StampedPose>& poses);
+
+/// Reads a TUM file (planar part); throws std::runtime_error "FILE:LINE: what" on malformed lines.
+std::vector<StampedPose> readTum(const std::string& path);
+
+}  // namespace laser_dpslam

@@ -1,0 +1,149 @@
+#include "laser_dpslam/laser_odometry.h"
+
+#include <cmath>
+
+#include "laser_dpslam/voxel_filter.h"
+
+namespace laser_dpslam {
+
+LaserOdometry::LaserOdometry(const LaserOdometryConfig& config)
+    : config_(config), matcher_(config.matcher), rng_(config.seed) {}
+
+void LaserOdometry::reset() {
+  initialized_ = false;
+  pose_ = Pose2D();
+  pose_covariance_.setZero();
+  velocity_.setZero();
+  keyframes_.clear();
+  rng_.seed(config_.seed);
+  scan_count_ = 0;
+}
+
+void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points) {
+  Keyframe kf;
+  kf.pose = pose_;
+  kf.points.reserve(base_points.size());
+  for (const auto& p : base_points) kf.points.push_back(pose_.transform(p));
+  kf.points = voxelFilter(kf.points, config_.map_voxel);
+  keyframes_.push_back(std::move(kf));
+  while (static_cast<int>(keyframes_.size()) > std::max(1, config_.local_map_keyframes)) keyframes_.pop_front();
+  std::vector<Eigen::Vector2d> map;
+  for (const auto& k : keyframes_) map.insert(map.end(), k.points.begin(), k.points.end());
+  matcher_.setReference(voxelFilter(map, config_.map_voxel));
+}
+
+namespace {
+// Jacobians of a ⊕ b with respect to a and b.
+void composeJacobians(const Pose2D& a, const Pose2D& b, Eigen::Matrix3d* Ja, Eigen::Matrix3d* Jb) {
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  *Ja << 1, 0, -s * b.x - c * b.y, 0, 1, c * b.x - s * b.y, 0, 0, 1;
+  *Jb << c, -s, 0, s, c, 0, 0, 0, 1;
+}
+}  // namespace
+
+OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserMount& mount) {
+  OdometryUpdate u;
+  u.stamp = scan.stamp;
+
+  if (initialized_ && scan.stamp < last_stamp_) {
+    // Time went backwards (a bag looped): start over rather than match across the jump.
+    reset();
+    u.skip_reason = "time_backwards";
+  } else if (initialized_ && scan.stamp == last_stamp_) {
+    u.skip_reason = "duplicate_stamp";
+    u.pose = pose_;
+    u.pose_covariance = pose_covariance_;
+    return u;
+  }
+
+  const std::vector<Eigen::Vector2d> base_points = mount.apply(scan.points);
+  if (!scan.ok() || static_cast<int>(base_points.size()) < config_.min_points) {
+    // Nothing to match: propagate with the velocity prior (bounded by the gap rule) and say so.
+    const double dt = initialized_ ? scan.stamp - last_stamp_ : 0.0;
+    if (initialized_ && dt > 0.0 && dt <= config_.max_prior_gap) {
+      const Pose2D d(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
+      pose_ = pose_ * d;
+      u.delta = d;
+      last_stamp_ = scan.stamp;
+    }
+    if (u.skip_reason.empty()) u.skip_reason = scan.ok() ? "too_few_points" : "malformed_scan";
+    u.pose = pose_;
+    u.pose_covariance = pose_covariance_;
+    u.velocity = velocity_;
+    return u;
+  }
+
+  if (!initialized_) {
+    initialized_ = true;
+    last_stamp_ = scan.stamp;
+    pose_ = Pose2D();
+    pose_covariance_.setZero();
+    velocity_.setZero();
+    addKeyframe(base_points);
+    u.ok = true;
+    u.reset = true;
+    u.new_keyframe = true;
+    u.pose = pose_;
+    u.delta_covariance = Eigen::Matrix3d::Zero();
+    u.points_used = static_cast<int>(base_points.size());
+    ++scan_count_;
+    return u;
+  }
+
+  const double dt = scan.stamp - last_stamp_;
+  // Constant-velocity prior; after a long gap the last velocity says nothing.
+  Pose2D prior_delta;
+  if (dt <= config_.max_prior_gap) prior_delta = Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
+  const Pose2D prior = pose_ * prior_delta;
+
+  const std::vector<Eigen::Vector2d> match_points = mount.apply(
+      resampleScan(scan, config_.resampling, static_cast<std::size_t>(std::max(1, config_.resampling_budget)),
+                   config_.saliency, config_.seed + scan_count_));
+  const std::vector<Eigen::Vector2d> polish_points =
+      config_.polish_budget > 0 && static_cast<int>(scan.points.size()) > config_.polish_budget
+          ? mount.apply(resampleScan(scan, ResamplingMethod::kUniform, static_cast<std::size_t>(config_.polish_budget),
+                                     config_.saliency, 0))
+          : base_points;
+  ++scan_count_;
+  u.points_used = static_cast<int>(polish_points.size());
+  u.match = matcher_.match(match_points, polish_points, prior, rng_);
+  if (!u.match.valid) {
+    u.skip_reason = "match_failed";
+    pose_ = prior;
+    last_stamp_ = scan.stamp;
+    u.pose = pose_;
+    u.pose_covariance = pose_covariance_;
+    return u;
+  }
+
+  const Pose2D previous = pose_;
+  pose_ = u.match.pose;
+  u.delta = between(previous, pose_);
+  // The match covariance is in the odom frame; the delta's lives in the previous base frame.
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  R.topLeftCorner<2, 2>() = previous.rotation();
+  u.delta_covariance = R.transpose() * u.match.covariance * R;
+  Eigen::Matrix3d Ja, Jb;
+  composeJacobians(previous, u.delta, &Ja, &Jb);
+  pose_covariance_ = Ja * pose_covariance_ * Ja.transpose() + Jb * u.delta_covariance * Jb.transpose();
+  if (dt > 0.0 && dt <= config_.max_prior_gap) {
+    velocity_ = Eigen::Vector3d(u.delta.x, u.delta.y, u.delta.theta) / dt;
+  } else {
+    velocity_.setZero();
+  }
+  last_stamp_ = scan.stamp;
+
+  const Pose2D from_kf = between(keyframes_.back().pose, pose_);
+  if (std::hypot(from_kf.x, from_kf.y) > config_.keyframe_distance ||
+      std::abs(from_kf.theta) > config_.keyframe_angle) {
+    addKeyframe(base_points);
+    u.new_keyframe = true;
+  }
+  u.ok = true;
+  u.pose = pose_;
+  u.pose_covariance = pose_covariance_;
+  u.velocity = velocity_;
+  return u;
+}
+
+}  // namespace laser_dpslam

@@ -1,0 +1,135 @@
+#include "laser_dpslam/ndt_grid.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+
+namespace laser_dpslam {
+
+namespace {
+struct Accumulator {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
+  int n = 0;
+};
+}  // namespace
+
+void NdtGrid::build(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config) {
+  config_ = config;
+  valid_cells_ = 0;
+  for (auto& layer : layers_) {
+    layer.nx = layer.ny = 0;
+    layer.cells.clear();
+  }
+  if (points.empty() || !(config.cell_size > 0.0)) return;
+
+  Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (const auto& p : points) {
+    if (!p.allFinite()) continue;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  if (!lo.allFinite()) return;
+
+  const double L = config.cell_size, inv = 1.0 / L;
+  std::vector<Accumulator> acc;
+  for (int k = 0; k < 4; ++k) {
+    Layer& layer = layers_[k];
+    // Shift by L/2 in x and/or y (Biber & Straßer): every point falls in four cells.
+    const Eigen::Vector2d shift(0.5 * L * (k & 1), 0.5 * L * (k >> 1));
+    layer.origin = (Eigen::Vector2d((std::floor(lo.x() * inv)), std::floor(lo.y() * inv)) * L) - Eigen::Vector2d(L, L) + shift;
+    layer.nx = static_cast<int>(std::floor((hi.x() - layer.origin.x()) * inv)) + 2;
+    layer.ny = static_cast<int>(std::floor((hi.y() - layer.origin.y()) * inv)) + 2;
+    const std::size_t n_cells = static_cast<std::size_t>(layer.nx) * layer.ny;
+    acc.assign(n_cells, Accumulator());
+    for (const auto& p : points) {
+      if (!p.allFinite()) continue;
+      const int ix = static_cast<int>((p.x() - layer.origin.x()) * inv);
+      const int iy = static_cast<int>((p.y() - layer.origin.y()) * inv);
+      if (ix < 0 || iy < 0 || ix >= layer.nx || iy >= layer.ny) continue;
+      Accumulator& a = acc[static_cast<std::size_t>(iy) * layer.nx + ix];
+      a.sum += p;
+      a.sum_sq += p * p.transpose();
+      ++a.n;
+    }
+    layer.cells.assign(n_cells, NdtCell());
+    for (std::size_t i = 0; i < n_cells; ++i) {
+      const Accumulator& a = acc[i];
+      if (a.n < config.min_points) continue;
+      NdtCell& c = layer.cells[i];
+      c.count = a.n;
+      c.mean = a.sum / a.n;
+      // Sample covariance (K − n·μμᵀ)/(n − 1): the minus sign matters (algorithms.md §2, known bug).
+      Eigen::Matrix2d cov = (a.sum_sq - a.n * c.mean * c.mean.transpose()) / (a.n - 1);
+      // Regularise by rebuilding from the eigenvectors with a clamped smallest eigenvalue.
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+      es.computeDirect(cov);  // closed form for 2×2
+      Eigen::Vector2d ev = es.eigenvalues();
+      const double lmax = std::max(ev.maxCoeff(), config.min_eigen);
+      const double floor_ev = std::max(config.eigen_ratio * lmax, config.min_eigen);
+      ev = ev.cwiseMax(floor_ev);
+      if (!ev.allFinite()) continue;
+      const Eigen::Matrix2d& V = es.eigenvectors();
+      c.covariance = V * ev.asDiagonal() * V.transpose();
+      c.information = V * ev.cwiseInverse().asDiagonal() * V.transpose();
+      c.valid = true;
+      ++valid_cells_;
+    }
+  }
+}
+
+double NdtGrid::density(const Eigen::Vector2d& p) const {
+  const double inv = 1.0 / config_.cell_size;
+  double s = 0.0;
+  for (const Layer& layer : layers_) {
+    const NdtCell* c = layer.cellAt(p, inv);
+    if (!c) continue;
+    const Eigen::Vector2d q = p - c->mean;
+    s += std::exp(-0.5 * q.dot(c->information * q));
+  }
+  return s;
+}
+
+NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points,
+                        bool derivatives) const {
+  NdtScore out;
+  if (valid_cells_ == 0) return out;
+  const double inv = 1.0 / config_.cell_size;
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  for (const auto& a : points) {
+    const Eigen::Vector2d x(c * a.x() - s * a.y() + pose.x, s * a.x() + c * a.y() + pose.y);
+    // Jacobian column for θ and the only non-zero second derivative (∂²x'/∂θ²), at the scan-frame point.
+    const Eigen::Vector2d j_theta(-s * a.x() - c * a.y(), c * a.x() - s * a.y());
+    const Eigen::Vector2d h_theta(-c * a.x() + s * a.y(), -s * a.x() - c * a.y());
+    bool matched = false;
+    for (const Layer& layer : layers_) {
+      const NdtCell* cell = layer.cellAt(x, inv);
+      if (!cell) continue;
+      const Eigen::Vector2d q = x - cell->mean;
+      const Eigen::Vector2d iq = cell->information * q;  // Σ⁻¹q (Σ symmetric)
+      const double m2 = q.dot(iq);
+      const double e = std::exp(-0.5 * m2);
+      out.h -= e;
+      if (m2 < 9.0) matched = true;
+      if (!derivatives) continue;
+      // g_k = e·qᵀΣ⁻¹J_k; J = [e_x, e_y, j_theta].
+      const Eigen::Vector3d qJ(iq.x(), iq.y(), iq.dot(j_theta));
+      out.gradient += e * qJ;
+      // H_kl = e·[−(qᵀΣ⁻¹J_k)(qᵀΣ⁻¹J_l) + qᵀΣ⁻¹∂²x'/∂p_k∂p_l + J_lᵀΣ⁻¹J_k]
+      Eigen::Matrix3d JtIJ;
+      const Eigen::Matrix2d& I = cell->information;
+      const Eigen::Vector2d Ij = I * j_theta;
+      JtIJ << I(0, 0), I(0, 1), Ij.x(),
+              I(1, 0), I(1, 1), Ij.y(),
+              Ij.x(), Ij.y(), j_theta.dot(Ij);
+      Eigen::Matrix3d Hk = -qJ * qJ.transpose() + JtIJ;
+      Hk(2, 2) += iq.dot(h_theta);
+      out.hessian += e * Hk;
+    }
+    if (matched) ++out.matched;
+  }
+  return out;
+}
+
+}  // namespace laser_dpslam

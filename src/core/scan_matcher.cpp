@@ -1,0 +1,145 @@
+#include "laser_dpslam/scan_matcher.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace laser_dpslam {
+
+ScanMatcher::ScanMatcher(const ScanMatcherConfig& config) : config_(config) {
+  if (config_.cell_sizes.empty()) throw std::invalid_argument("ScanMatcher: cell_sizes is empty");
+  for (double L : config_.cell_sizes) {
+    if (!(L > 0.0)) throw std::invalid_argument("ScanMatcher: cell sizes must be positive");
+  }
+}
+
+void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points) {
+  grids_.resize(config_.cell_sizes.size());
+  for (std::size_t i = 0; i < grids_.size(); ++i) {
+    NdtGridConfig c = config_.ndt;
+    c.cell_size = config_.cell_sizes[i];
+    grids_[i].build(points, c);
+  }
+  if (config_.use_de) raster_.build(grids_.front(), config_.raster_resolution);
+}
+
+bool ScanMatcher::hasReference() const { return !grids_.empty() && !grids_.back().empty(); }
+
+Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
+                           int* iterations) const {
+  const NdtGrid& grid = grids_.at(level);
+  Pose2D pose = start;
+  NdtScore s = grid.score(pose, points, true);
+  int it = 0;
+  for (; it < config_.newton_iterations; ++it) {
+    // Newton with the Hessian made positive definite (algorithms.md §2).
+    Eigen::Matrix3d H = s.hessian;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(H, Eigen::EigenvaluesOnly);
+    const double lmin = es.eigenvalues()(0);
+    if (lmin <= 0.0) H += (1.0 - 1.1 * lmin) * Eigen::Matrix3d::Identity();
+    Eigen::Vector3d delta = -H.ldlt().solve(s.gradient);
+    if (!delta.allFinite()) break;
+    // Backtracking: a Newton step on a sum of Gaussians can overshoot.
+    double step = 1.0;
+    bool improved = false;
+    for (int k = 0; k < 6; ++k) {
+      const Pose2D cand(pose.x + step * delta.x(), pose.y + step * delta.y(),
+                        normalizeAngle(pose.theta + step * delta.z()));
+      NdtScore cs = grid.score(cand, points, true);
+      if (cs.h <= s.h) {
+        pose = cand;
+        s = cs;
+        improved = true;
+        break;
+      }
+      step *= 0.5;
+    }
+    if (!improved) break;
+    if ((step * delta).head<2>().norm() < config_.newton_tolerance &&
+        std::abs(step * delta.z()) < config_.newton_tolerance) {
+      ++it;
+      break;
+    }
+  }
+  if (iterations) *iterations += it;
+  return pose;
+}
+
+Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, MatchResult& r) const {
+  // Σ = α·H⁻¹ + Σ_min (algorithms.md §2 [P]): h is not a normalised likelihood, so H⁻¹ alone is
+  // over-confident. H's eigenvalues are floored so that a singular H still gives a finite (large) Σ.
+  const Eigen::Matrix3d Hs = 0.5 * (hessian + hessian.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(Hs);
+  const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(1e-9 * std::max(es.eigenvalues().maxCoeff(), 1e-9));
+  Eigen::Matrix3d cov = config_.covariance_scale * es.eigenvectors() * ev.cwiseInverse().asDiagonal() *
+                        es.eigenvectors().transpose();
+  // Degeneracy (corridors, a single wall): a translation direction the scan barely constrains. Say so in
+  // the covariance with a large σ along it, rather than trusting a tiny curvature.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
+  et.computeDirect(Eigen::Matrix2d(Hs.topLeftCorner<2, 2>()));
+  const double tmax = std::max(et.eigenvalues()(1), 1e-12);
+  r.degenerate = !(et.eigenvalues()(0) > config_.degeneracy_ratio * tmax);
+  if (r.degenerate) {
+    const Eigen::Vector2d v = et.eigenvectors().col(0);
+    cov.topLeftCorner<2, 2>() += config_.degenerate_sigma * config_.degenerate_sigma * v * v.transpose();
+  }
+  cov(0, 0) += config_.min_sigma_xy * config_.min_sigma_xy;
+  cov(1, 1) += config_.min_sigma_xy * config_.min_sigma_xy;
+  cov(2, 2) += config_.min_sigma_theta * config_.min_sigma_theta;
+  if (r.weak) cov *= config_.weak_inflation;
+  return 0.5 * (cov + cov.transpose());
+}
+
+MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
+                               const std::vector<Eigen::Vector2d>& polish_points, const Pose2D& prior,
+                               std::mt19937_64& rng) const {
+  MatchResult r;
+  r.pose = prior;
+  if (!hasReference() || points.empty() || polish_points.empty()) return r;
+
+  Pose2D start = prior;
+  if (config_.use_de && !raster_.empty()) {
+    using DE = DifferentialEvolution<3>;
+    DE::Config dc;
+    dc.population = config_.de_population;
+    dc.max_generations = config_.de_generations;
+    dc.F = config_.de_F;
+    dc.CR = config_.de_CR;
+    dc.dither = config_.de_dither;
+    dc.strategy = DE::Strategy::kRand1Bin;
+    dc.spread_tolerance = Eigen::Vector3d(config_.de_spread_xy, config_.de_spread_xy, config_.de_spread_theta);
+    dc.stall_generations = config_.de_stall_generations;
+    const Eigen::Vector3d w(config_.window_xy, config_.window_xy, config_.window_theta);
+    const Eigen::Vector3d p0 = prior.vector();
+    // θ is searched unwrapped around the prior; normalised when the pose is formed.
+    auto cost = [&](const Eigen::Vector3d& x) { return raster_.cost(Pose2D(x.x(), x.y(), x.z()), points); };
+    const DE de(dc);
+    const DE::Result res = de.minimize(cost, p0 - w, p0 + w, {p0}, rng);
+    r.de_generations = res.generations;
+    r.de_evaluations = res.evaluations;
+    start = Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
+  }
+
+  Pose2D pose = start;
+  for (std::size_t level = 0; level < grids_.size(); ++level) {
+    if (grids_[level].empty()) continue;
+    pose = polish(polish_points, pose, level, &r.newton_iterations);
+  }
+  r.pose = pose;
+
+  const NdtScore s = grids_.back().score(pose, polish_points, true);
+  r.hessian = s.hessian;
+  r.score_per_point = -s.h / (4.0 * static_cast<double>(polish_points.size()));
+  r.matched_fraction = static_cast<double>(s.matched) / static_cast<double>(polish_points.size());
+  r.weak = r.score_per_point < config_.weak_score || r.matched_fraction < config_.weak_matched_fraction;
+  r.covariance = covarianceFrom(s.hessian, r);
+  r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
+  if (!r.valid) r.pose = prior;
+  return r;
+}
+
+}  // namespace laser_dpslam

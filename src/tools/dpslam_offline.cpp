@@ -1,0 +1,259 @@
+// dpslam_offline: runs the laser odometry (and, without --odometry-only, the SLAM) on a bag as fast as
+// the CPU allows, without a ROS master. Interface: ../shared/docs/interfaces.md.
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <set>
+#include <string>
+#include <sys/stat.h>
+#include <vector>
+
+#include "laser_dpslam/laser_odometry.h"
+#include "laser_dpslam/odometry_parameters.h"
+#include "laser_dpslam/parameter_source.h"
+#include "laser_dpslam/ros/bag_tf.h"
+#include "laser_dpslam/ros/msg_conversion.h"
+#include "laser_dpslam/run_statistics.h"
+#include "laser_dpslam/scan_preprocessor.h"
+#include "laser_dpslam/trajectory_io.h"
+
+using namespace laser_dpslam;
+
+namespace {
+
+const char* kUsage =
+    "usage: dpslam_offline --bag IN.bag --out DIR [--scan-topic /scan] [--config FILE.yaml]... [--seed N]\n"
+    "                      [--odometry-only] [--base-frame base_link] [--laser-pose X Y YAW] [--quiet]\n";
+
+struct Args {
+  std::string bag, out, scan_topic = "/scan", base_frame = "base_link";
+  std::vector<std::string> configs;
+  bool has_seed = false;
+  long long seed = 0;
+  bool odometry_only = false;
+  bool has_laser_pose = false;
+  double laser_pose[3] = {0, 0, 0};
+  bool quiet = false;
+};
+
+[[noreturn]] void usageError(const std::string& what) {
+  std::cerr << "dpslam_offline: " << what << "\n" << kUsage;
+  std::exit(2);
+}
+
+double parseNumber(const std::string& flag, const char* s) {
+  char* end = nullptr;
+  const double v = std::strtod(s, &end);
+  if (end == s || *end != '\0' || !std::isfinite(v)) usageError(flag + " expects a number, got '" + s + "'");
+  return v;
+}
+
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string f = argv[i];
+    auto next = [&](int k = 1) {
+      if (i + k >= argc) usageError(f + " needs " + std::to_string(k) + " value(s)");
+      return argv[++i];
+    };
+    if (f == "--bag") a.bag = next();
+    else if (f == "--out") a.out = next();
+    else if (f == "--scan-topic") a.scan_topic = next();
+    else if (f == "--config") a.configs.push_back(next());
+    else if (f == "--base-frame") a.base_frame = next();
+    else if (f == "--seed") {
+      const double v = parseNumber(f, next());
+      if (v < 0 || v != std::floor(v)) usageError("--seed expects a non-negative integer");
+      a.has_seed = true;
+      a.seed = static_cast<long long>(v);
+    } else if (f == "--odometry-only") a.odometry_only = true;
+    else if (f == "--quiet") a.quiet = true;
+    else if (f == "--laser-pose") {
+      if (i + 3 >= argc) usageError("--laser-pose needs X Y YAW");
+      for (double& v : a.laser_pose) v = parseNumber(f, argv[++i]);
+      a.has_laser_pose = true;
+    } else if (f == "-h" || f == "--help") {
+      std::cout << kUsage;
+      std::exit(0);
+    } else usageError("unknown argument '" + f + "'");
+  }
+  if (a.bag.empty()) usageError("--bag is required");
+  if (a.out.empty()) usageError("--out is required");
+  return a;
+}
+
+void progress(std::size_t done, std::size_t total) {
+  const int width = 40;
+  const int filled = total ? static_cast<int>(width * done / total) : width;
+  std::fprintf(stdout, "\r[%s%s] %zu/%zu scans", std::string(filled, '#').c_str(),
+               std::string(width - filled, ' ').c_str(), done, total);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parseArgs(argc, argv);
+
+  LaserOdometryConfig odom_config;
+  ScanPreprocessorConfig pre_config;
+  try {
+    for (const auto& path : args.configs) {
+      readOdometryParameters(YamlParameterSource::load(path), odom_config, pre_config);
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "dpslam_offline: " << e.what() << "\n";
+    return 2;
+  }
+  if (args.has_seed) odom_config.seed = static_cast<std::uint64_t>(args.seed);
+  if (!args.odometry_only) {
+    std::cerr << "dpslam_offline: the DP-SLAM stage is not built yet; run with --odometry-only\n";
+    return 2;
+  }
+
+  if (::mkdir(args.out.c_str(), 0755) != 0 && errno != EEXIST) {
+    std::cerr << "dpslam_offline: cannot create output directory '" << args.out << "': " << std::strerror(errno) << "\n";
+    return 1;
+  }
+
+  rosbag::Bag bag;
+  try {
+    bag.open(args.bag, rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    std::cerr << "dpslam_offline: cannot read bag '" << args.bag << "': " << e.what() << "\n";
+    return 1;
+  }
+
+  // Accept the topic with or without its leading slash.
+  std::vector<std::string> topics{args.scan_topic};
+  if (!args.scan_topic.empty() && args.scan_topic[0] == '/') topics.push_back(args.scan_topic.substr(1));
+  else topics.push_back("/" + args.scan_topic);
+  rosbag::View view(bag, rosbag::TopicQuery(topics));
+  const std::size_t total = view.size();
+  if (total == 0) {
+    std::set<std::string> scan_topics;
+    rosbag::View all(bag);
+    for (const auto* c : all.getConnections()) {
+      if (c->datatype == "sensor_msgs/LaserScan") scan_topics.insert(c->topic);
+    }
+    std::string list;
+    for (const auto& t : scan_topics) list += " " + t;
+    std::cerr << "dpslam_offline: no messages on " << args.scan_topic << " in '" << args.bag
+              << "'; LaserScan topics in the bag:" << (list.empty() ? " none" : list) << " (use --scan-topic)\n";
+    return 1;
+  }
+
+  const bool show_progress = !args.quiet && ::isatty(STDOUT_FILENO);
+  LaserOdometry odometry(odom_config);
+  LaserMount mount;
+  bool mount_known = false;
+  std::string laser_frame;
+  std::vector<StampedPose> odom_poses;
+  std::vector<double> odom_ms;
+  std::map<std::string, int> skipped;
+  int matched = 0, bad = 0;
+  double first_stamp = 0.0, last_stamp = 0.0;
+  std::size_t done = 0;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const double cpu0 = processCpuSeconds();
+
+  for (const rosbag::MessageInstance& m : view) {
+    ++done;
+    sensor_msgs::LaserScan::ConstPtr msg = m.instantiate<sensor_msgs::LaserScan>();
+    if (!msg) {
+      ++skipped["not_a_laser_scan"];
+      continue;
+    }
+    if (!mount_known) {
+      laser_frame = cleanFrameId(msg->header.frame_id);
+      if (args.has_laser_pose) {
+        mount = LaserMount::fromPose(Pose2D(args.laser_pose[0], args.laser_pose[1], args.laser_pose[2]));
+      } else {
+        geometry_msgs::Transform t;
+        std::string error;
+        if (laser_frame == cleanFrameId(args.base_frame)) {
+          mount = LaserMount();
+        } else if (findBagTransform(bag, args.base_frame, laser_frame, &t, &error)) {
+          mount = mountFromTransform(t);
+        } else {
+          std::cerr << "dpslam_offline: warning: " << error << "; taking the laser to be at " << args.base_frame
+                    << " (use --laser-pose X Y YAW to override)\n";
+        }
+      }
+      mount_known = true;
+    }
+    const LaserScan scan = fromMsg(*msg);
+    const double t0 = threadCpuSeconds();
+    const PreprocessedScan pre = preprocessScan(scan, pre_config);
+    const OdometryUpdate u = odometry.process(pre, mount);
+    const double ms = 1e3 * (threadCpuSeconds() - t0);
+
+    if (odom_poses.empty()) first_stamp = scan.stamp;
+    if (!u.ok) {
+      ++skipped[pre.ok() ? u.skip_reason : "malformed_scan"];
+      if (u.skip_reason == "time_backwards" || u.skip_reason == "duplicate_stamp" || !pre.ok()) {
+        if (show_progress && done % 20 == 0) progress(done, total);
+        continue;
+      }
+    } else {
+      odom_ms.push_back(ms);
+      if (!u.reset) {
+        ++matched;
+        if (u.match.weak || u.match.degenerate) ++bad;
+      }
+    }
+    if (!odom_poses.empty() && scan.stamp <= odom_poses.back().stamp) {
+      // Time went backwards: the odometry restarted; the TUM file keeps a monotonic time line.
+      ++skipped["time_backwards"];
+      continue;
+    }
+    odom_poses.push_back({scan.stamp, u.pose});
+    last_stamp = scan.stamp;
+    if (show_progress && done % 20 == 0) progress(done, total);
+  }
+  if (show_progress) {
+    progress(done, total);
+    std::fprintf(stdout, "\n");
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const double cpu = processCpuSeconds() - cpu0;
+  const double duration = last_stamp - first_stamp;
+
+  try {
+    writeFileAtomically(args.out + "/odometry.tum", formatTum(odom_poses));
+    std::string json = "{\n";
+    json += "  \"scans\": " + std::to_string(total) + ",\n";
+    json += "  \"data_duration_s\": " + jsonNumber(duration) + ",\n";
+    json += "  \"wall_s\": " + jsonNumber(wall) + ",\n";
+    json += "  \"cpu_s\": " + jsonNumber(cpu) + ",\n";
+    json += "  \"realtime_factor\": " + jsonNumber(wall > 0 ? duration / wall : 0.0) + ",\n";
+    json += "  \"odometry_ms\": " + jsonTiming(summarize(odom_ms)) + ",\n";
+    json += "  \"slam_ms\": null,\n";
+    json += "  \"peak_rss_mb\": " + jsonNumber(peakRssMb()) + ",\n";
+    json += "  \"particles\": 0,\n";
+    json += "  \"seed\": " + std::to_string(odom_config.seed) + ",\n";
+    json += "  \"bad_match_percent\": " + jsonNumber(matched ? 100.0 * bad / matched : 0.0) + ",\n";
+    json += "  \"resampling\": " + jsonString(resamplingMethodName(odom_config.resampling)) + ",\n";
+    json += "  \"mode\": \"odometry-only\",\n";
+    json += "  \"skipped\": " + jsonCounts(skipped) + "\n}\n";
+    writeFileAtomically(args.out + "/stats.json", json);
+  } catch (const std::exception& e) {
+    std::cerr << "dpslam_offline: " << e.what() << "\n";
+    return 1;
+  }
+  if (!args.quiet) {
+    std::printf("dpslam_offline: %zu scans, %.1f s of data in %.2f s (%.1fx real time), odometry median %.3f ms; wrote %s\n",
+                total, duration, wall, wall > 0 ? duration / wall : 0.0, summarize(odom_ms).median, args.out.c_str());
+  }
+  return 0;
+}
