@@ -48,6 +48,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(m.min_sigma_theta, dm.min_sigma_theta);
   EXPECT_EQ(m.degeneracy_ratio, dm.degeneracy_ratio);
   EXPECT_EQ(m.degenerate_sigma, dm.degenerate_sigma);
+  EXPECT_EQ(m.keep_prior_when_degenerate, dm.keep_prior_when_degenerate);
   EXPECT_EQ(m.weak_score, dm.weak_score);
   EXPECT_EQ(m.weak_matched_fraction, dm.weak_matched_fraction);
   EXPECT_EQ(m.weak_inflation, dm.weak_inflation);

@@ -44,6 +44,7 @@ struct ScanMatcherConfig {
   double min_sigma_theta = 0.002;       ///< rad, standard deviation floor
   double degeneracy_ratio = 0.02;       ///< eigenvalue of H's translation block below this × its largest: degenerate
   double degenerate_sigma = 0.3;        ///< m, σ added along a degenerate translation direction
+  bool keep_prior_when_degenerate = true;  ///< along a degenerate direction keep the motion prior (corridors)
   double weak_score = 0.25;             ///< score per point (0…1) below which the match is weak
   double weak_matched_fraction = 0.5;   ///< matched fraction below which the match is weak
   double weak_inflation = 10.0;         ///< covariance multiplier for a weak match
@@ -82,9 +83,10 @@ class ScanMatcher {
   MatchResult match(const std::vector<Eigen::Vector2d>& search_points, const std::vector<Eigen::Vector2d>& polish_points,
                     const Pose2D& prior, std::mt19937_64& rng) const;
 
-  /// Newton polish only, from `start`, on resolution level `level` (exposed for tests).
+  /// Newton polish only, from `start`, on resolution level `level` (exposed for tests). With `basis`
+  /// (3×k, orthonormal columns) the steps stay in the subspace it spans.
   Pose2D polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
-                int* iterations = nullptr) const;
+                int* iterations = nullptr, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis = nullptr) const;
 
   const ScanMatcherConfig& config() const { return config_; }
   const NdtGrid& grid(std::size_t level) const { return grids_.at(level); }

@@ -78,6 +78,7 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   positive(s, "min_sigma_theta", m.min_sigma_theta);
   positive(s, "degeneracy_ratio", m.degeneracy_ratio);
   positive(s, "degenerate_sigma", m.degenerate_sigma);
+  s.get("keep_prior_when_degenerate", m.keep_prior_when_degenerate);
   nonNegative(s, "weak_score", m.weak_score);
   nonNegative(s, "weak_matched_fraction", m.weak_matched_fraction);
   positive(s, "weak_inflation", m.weak_inflation);

@@ -28,7 +28,7 @@ void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points) {
 bool ScanMatcher::hasReference() const { return !grids_.empty() && !grids_.back().empty(); }
 
 Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
-                           int* iterations) const {
+                           int* iterations, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis) const {
   const NdtGrid& grid = grids_.at(level);
   Pose2D pose = start;
   NdtScore s = grid.score(pose, points, true);
@@ -40,7 +40,14 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
     es.computeDirect(H, Eigen::EigenvaluesOnly);
     const double lmin = es.eigenvalues()(0);
     if (lmin <= 0.0) H += (1.0 - 1.1 * lmin) * Eigen::Matrix3d::Identity();
-    Eigen::Vector3d delta = -H.ldlt().solve(s.gradient);
+    Eigen::Vector3d delta;
+    if (basis) {
+      // Newton in the subspace: Δ = B (BᵀHB)⁻¹ Bᵀ(−g).
+      const Eigen::MatrixXd Hb = basis->transpose() * H * *basis;
+      delta = -*basis * Hb.ldlt().solve(basis->transpose() * s.gradient);
+    } else {
+      delta = -H.ldlt().solve(s.gradient);
+    }
     if (!delta.allFinite()) break;
     // Backtracking: a Newton step on a sum of Gaussians can overshoot.
     double step = 1.0;
@@ -129,9 +136,25 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     if (grids_[level].empty()) continue;
     pose = polish(polish_points, pose, level, &r.newton_iterations);
   }
+  NdtScore s = grids_.back().score(pose, polish_points, true);
+  if (config_.keep_prior_when_degenerate) {
+    // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
+    // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
+    // (LOAM-style solution remapping, Zhang et al. 2016).
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
+    et.computeDirect(Eigen::Matrix2d(0.5 * (s.hessian.topLeftCorner<2, 2>() + s.hessian.topLeftCorner<2, 2>().transpose())));
+    if (!(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12))) {
+      const Eigen::Vector2d v = et.eigenvectors().col(0);
+      const Eigen::Vector2d d(pose.x - prior.x, pose.y - prior.y);
+      const Eigen::Vector2d xy = Eigen::Vector2d(pose.x, pose.y) - v * v.dot(d);
+      Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
+      basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
+      pose = polish(polish_points, Pose2D(xy.x(), xy.y(), pose.theta), grids_.size() - 1, &r.newton_iterations, &basis);
+      s = grids_.back().score(pose, polish_points, true);
+    }
+  }
   r.pose = pose;
 
-  const NdtScore s = grids_.back().score(pose, polish_points, true);
   r.hessian = s.hessian;
   r.score_per_point = -s.h / (4.0 * static_cast<double>(polish_points.size()));
   r.matched_fraction = static_cast<double>(s.matched) / static_cast<double>(polish_points.size());

@@ -33,7 +33,8 @@ namespace {
 
 const char* kUsage =
     "usage: dpslam_offline --bag IN.bag --out DIR [--scan-topic /scan] [--config FILE.yaml]... [--seed N]\n"
-    "                      [--odometry-only] [--base-frame base_link] [--laser-pose X Y YAW] [--quiet]\n";
+    "                      [--odometry-only] [--base-frame base_link] [--laser-pose X Y YAW] [--quiet]\n"
+    "                      [--match-log FILE.csv]   (one line per scan: the match's quality figures)\n";
 
 struct Args {
   std::string bag, out, scan_topic = "/scan", base_frame = "base_link";
@@ -44,6 +45,7 @@ struct Args {
   bool has_laser_pose = false;
   double laser_pose[3] = {0, 0, 0};
   bool quiet = false;
+  std::string match_log;
 };
 
 [[noreturn]] void usageError(const std::string& what) {
@@ -78,6 +80,7 @@ Args parseArgs(int argc, char** argv) {
       a.seed = static_cast<long long>(v);
     } else if (f == "--odometry-only") a.odometry_only = true;
     else if (f == "--quiet") a.quiet = true;
+    else if (f == "--match-log") a.match_log = next();
     else if (f == "--laser-pose") {
       if (i + 3 >= argc) usageError("--laser-pose needs X Y YAW");
       for (double& v : a.laser_pose) v = parseNumber(f, argv[++i]);
@@ -154,6 +157,7 @@ int main(int argc, char** argv) {
   }
 
   const bool show_progress = !args.quiet && ::isatty(STDOUT_FILENO);
+  std::string match_log = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt\n";
   LaserOdometry odometry(odom_config);
   LaserMount mount;
   bool mount_known = false;
@@ -198,6 +202,15 @@ int main(int argc, char** argv) {
     const OdometryUpdate u = odometry.process(pre, mount);
     const double ms = 1e3 * (threadCpuSeconds() - t0);
 
+    if (!args.match_log.empty()) {
+      char line[512];
+      std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g\n",
+                    scan.stamp, u.ok, u.skip_reason.c_str(), u.pose.x, u.pose.y, u.pose.theta, u.delta.x, u.delta.y,
+                    u.delta.theta, u.match.score_per_point, u.match.matched_fraction, u.match.degenerate, u.match.weak,
+                    u.match.de_generations, u.match.de_evaluations, u.match.newton_iterations, u.points_used,
+                    u.new_keyframe, ms, u.delta_covariance(0, 0), u.delta_covariance(1, 1), u.delta_covariance(2, 2));
+      match_log += line;
+    }
     if (odom_poses.empty()) first_stamp = scan.stamp;
     if (!u.ok) {
       ++skipped[pre.ok() ? u.skip_reason : "malformed_scan"];
@@ -231,6 +244,7 @@ int main(int argc, char** argv) {
 
   try {
     writeFileAtomically(args.out + "/odometry.tum", formatTum(odom_poses));
+    if (!args.match_log.empty()) writeFileAtomically(args.match_log, match_log);
     std::string json = "{\n";
     json += "  \"scans\": " + std::to_string(total) + ",\n";
     json += "  \"data_duration_s\": " + jsonNumber(duration) + ",\n";
