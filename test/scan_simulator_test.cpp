@@ -127,6 +127,24 @@ TEST(ScanSimulator, BeyondRangeMaxIsPositiveInfinity) {
   }
   EXPECT_GT(inf, 100);
   EXPECT_GT(finite, 100);
+
+  // With range noise, no finite reading lies outside [range_min, range_max].
+  ScanSimulatorConfig noisy;
+  noisy.range_max = 2.0;
+  noisy.noise_min_stddev = 0.05;
+  ScanSimulator noisy_sim(plan, noisy, 9);
+  int near_max = 0;
+  for (int k = 0; k < 40; ++k) {
+    const Pose2D& pose = kPoses[k % kPoses.size()];
+    const LaserScan s = noisy_sim.simulate(pose, 1000.0);
+    for (std::size_t i = 0; i < s.ranges.size(); ++i) {
+      if (!std::isfinite(s.ranges[i])) continue;
+      EXPECT_LE(s.ranges[i], noisy.range_max);
+      EXPECT_GE(s.ranges[i], noisy.range_min);
+      near_max += s.ranges[i] > noisy.range_max - 0.05;
+    }
+  }
+  EXPECT_GT(near_max, 10);  // the check above was exercised
 }
 
 TEST(ScanSimulator, DropoutsAreNaNAtTheConfiguredRate) {

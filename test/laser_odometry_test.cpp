@@ -1,0 +1,126 @@
+#include "laser_dpslam/laser_odometry.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "laser_dpslam/scan_simulator.h"
+#include "laser_dpslam/sim_path.h"
+#include "test_rooms.h"
+
+using namespace laser_dpslam;
+
+namespace {
+
+// A loop around the furnished room at iRobot Create speeds, scanned at 10 Hz with URG-04LX noise.
+struct SimRun {
+  std::vector<TimedPose> truth;
+  std::vector<LaserScan> scans;
+};
+
+SimRun simulateLoop(std::uint64_t seed) {
+  static const FloorPlan room = test::furnishedRoom();
+  const std::vector<Eigen::Vector2d> waypoints{{1.5, 2.5}, {3.2, 3.0}, {6.5, 2.0}, {7.0, 5.0}, {4.5, 5.0}, {1.5, 3.5}, {1.5, 2.5}};
+  SimRun run;
+  run.truth = samplePath(waypoints, 10.0, PathConfig());
+  ScanSimulator sim(room, ScanSimulatorConfig(), seed);
+  for (const auto& tp : run.truth) run.scans.push_back(sim.simulate(tp.pose, 100.0 + tp.stamp));
+  return run;
+}
+
+}  // namespace
+
+TEST(LaserOdometry, TracksASimulatedLoopWithSmallDrift) {
+  const SimRun run = simulateLoop(1);
+  LaserOdometry odom;
+  double max_err = 0.0, travelled = 0.0;
+  const Pose2D start = run.truth.front().pose;
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    const OdometryUpdate u = odom.process(preprocessScan(run.scans[i], ScanPreprocessorConfig()), LaserMount());
+    ASSERT_TRUE(u.ok) << "scan " << i << ": " << u.skip_reason;
+    const Pose2D truth = between(start, run.truth[i].pose);  // odometry starts at the identity
+    max_err = std::max(max_err, std::hypot(u.pose.x - truth.x, u.pose.y - truth.y));
+    if (i > 0) {
+      travelled += std::hypot(run.truth[i].pose.x - run.truth[i - 1].pose.x, run.truth[i].pose.y - run.truth[i - 1].pose.y);
+    }
+    EXPECT_TRUE(u.pose_covariance.allFinite());
+    EXPECT_GE(u.delta_covariance(0, 0), 0.0);
+  }
+  const Pose2D end_truth = between(start, run.truth.back().pose);
+  const double final_err = std::hypot(odom.pose().x - end_truth.x, odom.pose().y - end_truth.y);
+  ASSERT_GT(travelled, 15.0);
+  // Laser odometry drifts; on this small, well-structured room it must stay within 1 % of the path.
+  EXPECT_LT(final_err, 0.01 * travelled) << "travelled " << travelled;
+  EXPECT_LT(max_err, 0.15);
+  EXPECT_LT(std::abs(normalizeAngle(odom.pose().theta - end_truth.theta)), 1.0 * M_PI / 180.0);
+}
+
+TEST(LaserOdometry, SameSeedGivesIdenticalPoses) {
+  const SimRun run = simulateLoop(2);
+  LaserOdometry a, b;
+  for (std::size_t i = 0; i < 80; ++i) {
+    const PreprocessedScan s = preprocessScan(run.scans[i], ScanPreprocessorConfig());
+    const Pose2D pa = a.process(s, LaserMount()).pose, pb = b.process(s, LaserMount()).pose;
+    ASSERT_EQ(pa.x, pb.x);
+    ASSERT_EQ(pa.y, pb.y);
+    ASSERT_EQ(pa.theta, pb.theta);
+  }
+}
+
+TEST(LaserOdometry, BadScansAreSkippedAndNeverCorruptThePose) {
+  const SimRun run = simulateLoop(3);
+  LaserOdometry odom;
+  for (std::size_t i = 0; i < 60; ++i) {
+    LaserScan s = run.scans[i];
+    if (i % 10 == 5) {
+      // Only NaN / ±inf / out-of-range values (REP-117): nothing to match.
+      for (std::size_t k = 0; k < s.ranges.size(); ++k) {
+        const float bad[4] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                              -std::numeric_limits<float>::infinity(), 100.0f};
+        s.ranges[k] = bad[k % 4];
+      }
+    }
+    if (i % 10 == 7) s.angle_increment = 0.0;  // malformed
+    const OdometryUpdate u = odom.process(preprocessScan(s, ScanPreprocessorConfig()), LaserMount());
+    EXPECT_TRUE(u.pose.vector().allFinite());
+    EXPECT_TRUE(u.pose_covariance.allFinite());
+    if (i % 10 == 5) EXPECT_EQ(u.skip_reason, "too_few_points");
+    if (i % 10 == 7) EXPECT_EQ(u.skip_reason, "malformed_scan");
+    if (i % 10 != 5 && i % 10 != 7) EXPECT_TRUE(u.ok) << i;
+  }
+  // Still on track after the bad scans.
+  const Pose2D truth = between(run.truth.front().pose, run.truth[59].pose);
+  EXPECT_LT(std::hypot(odom.pose().x - truth.x, odom.pose().y - truth.y), 0.05);
+}
+
+TEST(LaserOdometry, TimeGoingBackwardsResetsAndDuplicatesAreSkipped) {
+  const SimRun run = simulateLoop(4);
+  LaserOdometry odom;
+  for (std::size_t i = 0; i < 30; ++i) odom.process(preprocessScan(run.scans[i], ScanPreprocessorConfig()), LaserMount());
+  EXPECT_GT(std::hypot(odom.pose().x, odom.pose().y), 0.05);
+  const OdometryUpdate dup = odom.process(preprocessScan(run.scans[29], ScanPreprocessorConfig()), LaserMount());
+  EXPECT_EQ(dup.skip_reason, "duplicate_stamp");
+  const OdometryUpdate back = odom.process(preprocessScan(run.scans[0], ScanPreprocessorConfig()), LaserMount());
+  EXPECT_EQ(back.skip_reason, "time_backwards");
+  EXPECT_TRUE(back.reset);
+  EXPECT_EQ(back.pose.x, 0.0);
+  EXPECT_EQ(back.pose.y, 0.0);
+}
+
+TEST(LaserOdometry, MountedLaserGivesTheBasePose) {
+  // Laser 0.2 m ahead of base_link and yawed 90°: the odometry must still report base_link's motion.
+  const FloorPlan room = test::furnishedRoom();
+  const Pose2D mount_pose(0.2, 0.0, M_PI / 2);
+  ScanSimulator sim(room, ScanSimulatorConfig(), 9);
+  const std::vector<Eigen::Vector2d> waypoints{{2.0, 2.5}, {5.0, 3.0}};
+  const auto truth = samplePath(waypoints, 10.0, PathConfig());
+  LaserOdometry odom;
+  for (const auto& tp : truth) {
+    odom.process(preprocessScan(sim.simulate(tp.pose * mount_pose, tp.stamp + 1.0), ScanPreprocessorConfig()),
+                 LaserMount::fromPose(mount_pose));
+  }
+  const Pose2D expected = between(truth.front().pose, truth.back().pose);
+  EXPECT_NEAR(odom.pose().x, expected.x, 0.03);
+  EXPECT_NEAR(odom.pose().y, expected.y, 0.03);
+  EXPECT_NEAR(odom.pose().theta, expected.theta, 0.01);
+}
