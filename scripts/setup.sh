@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Shared set-up for demo.sh, test.sh and run.sh: install the missing Debian packages, then build the
-# catkin workspace in .ws/ (the repository is linked in as .ws/src/laser_dpslam). Idempotent and quick
-# when nothing changed. Source it: it exports REPO, WS and sources the workspace.
+# Shared set-up for demo.sh, test.sh and run.sh: install the missing Debian packages, then build a
+# catkin workspace whose src/laser_dpslam links to this repository. The workspace lives outside the
+# repository (~/.cache/laser_dpslam/ws-<hash of the path>, or $LASER_DPSLAM_WS) so that rospack does not
+# see a file-system loop. Idempotent and quick when nothing changed. Source it: it exports REPO and WS
+# and sources the workspace.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WS="${LASER_DPSLAM_WS:-$REPO/.ws}"
+WS="${LASER_DPSLAM_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/laser_dpslam/ws-$(printf '%s' "$REPO" | md5sum | cut -c1-10)}"
 export REPO WS
 
 DEB_PACKAGES=(
@@ -30,7 +32,8 @@ if ((${#missing[@]})); then
 fi
 
 mkdir -p "$WS/src"
-if [[ ! -e "$WS/src/laser_dpslam" ]]; then
+if [[ "$(readlink "$WS/src/laser_dpslam" 2>/dev/null)" != "$REPO" ]]; then
+  rm -f "$WS/src/laser_dpslam"
   ln -s "$REPO" "$WS/src/laser_dpslam"
 fi
 
