@@ -49,7 +49,11 @@ echo "[laser_dpslam] building in $WS"
     exit 1
   fi
 )
-set +u
-# shellcheck disable=SC1091
-source "$WS/devel/setup.bash"
-set -u
+# Sourced from a function so that catkin's setup does not see the caller's arguments.
+_laser_dpslam_source_ws() {
+  set +u
+  # shellcheck disable=SC1091
+  source "$WS/devel/setup.bash"
+  set -u
+}
+_laser_dpslam_source_ws
