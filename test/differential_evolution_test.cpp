@@ -228,7 +228,9 @@ std::vector<int> checkCrossover(const Variant& v, double CR, int expect_min, int
       for (int j = 0; j < 3; ++j) changed += (trial(j) != pop[i](j));
       ++histogram[changed];
       EXPECT_LE(changed, expect_max) << v.name << " gen " << g << " member " << i;
-      if (g == 0) EXPECT_GE(changed, expect_min) << v.name << " member " << i;
+      if (g == 0) {
+        EXPECT_GE(changed, expect_min) << v.name << " member " << i;
+      }
       below += g < 5 && changed < expect_min;
       if (rec.cs[k] <= costs[i]) {
         next[i] = trial;

@@ -21,7 +21,7 @@ namespace laser_dpslam {
 struct LaserOdometryConfig {
   ResamplingMethod resampling = ResamplingMethod::kSaliency;  ///< points used to match each scan
   int resampling_budget = 100;       ///< points kept for the DE search
-  int polish_budget = 300;           ///< points (spatially uniform) for the Newton polish; 0 = all valid points
+  int polish_budget = 0;             ///< points (spatially uniform) for the Newton polish; 0 = all valid points
   SaliencyConfig saliency;
   ScanMatcherConfig matcher;
   double keyframe_distance = 0.25;   ///< m moved since the last keyframe before a new one is taken
