@@ -141,7 +141,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> topics{args.scan_topic};
   if (!args.scan_topic.empty() && args.scan_topic[0] == '/') topics.push_back(args.scan_topic.substr(1));
   else topics.push_back("/" + args.scan_topic);
-  rosbag::View view(bag, rosbag::TopicQuery(topics));
+  // From time 0, not View's default TIME_MIN: logs without time (DP-SLAM) start at 0.
+  rosbag::View view(bag, rosbag::TopicQuery(topics), ros::Time(0, 0), ros::TIME_MAX);
   const std::size_t total = view.size();
   if (total == 0) {
     std::set<std::string> scan_topics;
