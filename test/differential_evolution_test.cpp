@@ -318,6 +318,52 @@ TEST(DifferentialEvolution, MutationFormulas) {
   }
 }
 
+// jDE: a trial's F is the member's F, or with probability τ1 = 0.1 a fresh F ~ U(0.1, 1.0). Recover each
+// first-generation rand/1 trial's F from its mutant components and check both kinds occur, all in range.
+TEST(DifferentialEvolution, JdeRedrawsFWithinRange) {
+  const int np = 40;
+  auto cfg = makeConfig(allVariants()[2], np, 1, 0.6, 1.0);
+  ASSERT_TRUE(cfg.jde);
+  Recorder rec{sphere, {}, {}};
+  std::vector<V3> seeds;
+  std::mt19937_64 srng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < np; ++i) seeds.emplace_back(u(srng), u(srng), u(srng));
+  std::mt19937_64 rng(12);
+  DE3(cfg).minimize(std::ref(rec), box(-1000), box(1000), seeds, rng);
+  ASSERT_EQ(static_cast<int>(rec.xs.size()), 2 * np);
+  int configured = 0, redrawn = 0, explained = 0;
+  for (int i = 0; i < np; ++i) {
+    const V3& t = rec.xs[np + i];
+    std::vector<int> changed;
+    for (int j = 0; j < 3; ++j) {
+      if (t(j) != seeds[i](j)) changed.push_back(j);
+    }
+    if (changed.size() < 2) continue;  // CR re-drawn low: F not identifiable
+    bool found = false;
+    for (int a = 0; a < np && !found; ++a) {
+      for (int b = 0; b < np && !found; ++b) {
+        for (int c = 0; c < np && !found; ++c) {
+          if (a == i || b == i || c == i || a == b || a == c || b == c) continue;
+          const int j0 = changed[0];
+          const double f = (t(j0) - seeds[a](j0)) / (seeds[b](j0) - seeds[c](j0));
+          bool ok = f > 0.0;  // (a, c, b) explains the same trial with −F
+          for (int j : changed) ok = ok && std::abs(seeds[a](j) + f * (seeds[b](j) - seeds[c](j)) - t(j)) < 1e-9;
+          if (!ok) continue;
+          found = true;
+          EXPECT_GE(f, 0.1 - 1e-9);
+          EXPECT_LE(f, 1.0 + 1e-9);
+          (std::abs(f - 0.6) < 1e-9 ? configured : redrawn)++;
+        }
+      }
+    }
+    explained += found;
+  }
+  EXPECT_GT(explained, np / 2);
+  EXPECT_GT(configured, redrawn);
+  EXPECT_GT(redrawn, 0);
+}
+
 // ---- selection uses ≤ ------------------------------------------------------------------------------------
 TEST(DifferentialEvolution, EqualCostTrialReplacesTarget) {
   DE3 de(makeConfig(allVariants()[0], 10, 1));
