@@ -54,7 +54,9 @@ class LogToBagTest(unittest.TestCase):
         with rosbag.Bag(self.path('out.bag')) as bag:
             for topic, msg, t in bag.read_messages():
                 self.assertIn(topic, msgs)
-                self.assertEqual(t, msg.transforms[0].header.stamp if topic == '/tf_static' else msg.header.stamp)
+                stamp = msg.transforms[0].header.stamp if topic == '/tf_static' else msg.header.stamp
+                # Record time = header stamp, except that a stamp of 0 is recorded at 1 ns (ros::TIME_MIN).
+                self.assertEqual(t.to_nsec(), max(stamp.to_nsec(), 1))
                 msgs[topic].append(msg)
         self.assertEqual(len(msgs['/tf_static']), 1)
         tf = msgs['/tf_static'][0].transforms
