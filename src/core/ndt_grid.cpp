@@ -97,38 +97,47 @@ NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& 
   if (valid_cells_ == 0) return out;
   const double inv = 1.0 / config_.cell_size;
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  // Accumulated in scalars (this loop is the matcher's hot spot): gradient g0..g2 and the upper
+  // triangle of the symmetric Hessian.
+  double h = 0, g0 = 0, g1 = 0, g2 = 0, H00 = 0, H01 = 0, H02 = 0, H11 = 0, H12 = 0, H22 = 0;
   for (const auto& a : points) {
-    const Eigen::Vector2d x(c * a.x() - s * a.y() + pose.x, s * a.x() + c * a.y() + pose.y);
+    const double xx = c * a.x() - s * a.y() + pose.x, xy = s * a.x() + c * a.y() + pose.y;
     // Jacobian column for θ and the only non-zero second derivative (∂²x'/∂θ²), at the scan-frame point.
-    const Eigen::Vector2d j_theta(-s * a.x() - c * a.y(), c * a.x() - s * a.y());
-    const Eigen::Vector2d h_theta(-c * a.x() + s * a.y(), -s * a.x() - c * a.y());
+    const double jx = -s * a.x() - c * a.y(), jy = c * a.x() - s * a.y();
+    const double hx = -c * a.x() + s * a.y(), hy = -s * a.x() - c * a.y();
+    const Eigen::Vector2d x(xx, xy);
     bool matched = false;
     for (const Layer& layer : layers_) {
       const NdtCell* cell = layer.cellAt(x, inv);
       if (!cell) continue;
-      const Eigen::Vector2d q = x - cell->mean;
-      const Eigen::Vector2d iq = cell->information * q;  // Σ⁻¹q (Σ symmetric)
-      const double m2 = q.dot(iq);
-      const double e = std::exp(-0.5 * m2);
-      out.h -= e;
+      const double qx = xx - cell->mean.x(), qy = xy - cell->mean.y();
+      const double a00 = cell->information(0, 0), a01 = cell->information(0, 1), a11 = cell->information(1, 1);
+      const double iqx = a00 * qx + a01 * qy, iqy = a01 * qx + a11 * qy;  // Σ⁻¹q
+      const double m2 = qx * iqx + qy * iqy;
       if (m2 < 9.0) matched = true;
+      if (m2 > 40.0) continue;  // exp(−20) ≈ 2e-9: no contribution worth an exp()
+      const double e = std::exp(-0.5 * m2);
+      h -= e;
       if (!derivatives) continue;
-      // g_k = e·qᵀΣ⁻¹J_k; J = [e_x, e_y, j_theta].
-      const Eigen::Vector3d qJ(iq.x(), iq.y(), iq.dot(j_theta));
-      out.gradient += e * qJ;
+      // g_k = e·qᵀΣ⁻¹J_k with J = [e_x, e_y, j_θ].
+      const double qj = iqx * jx + iqy * jy;
+      g0 += e * iqx;
+      g1 += e * iqy;
+      g2 += e * qj;
       // H_kl = e·[−(qᵀΣ⁻¹J_k)(qᵀΣ⁻¹J_l) + qᵀΣ⁻¹∂²x'/∂p_k∂p_l + J_lᵀΣ⁻¹J_k]
-      Eigen::Matrix3d JtIJ;
-      const Eigen::Matrix2d& I = cell->information;
-      const Eigen::Vector2d Ij = I * j_theta;
-      JtIJ << I(0, 0), I(0, 1), Ij.x(),
-              I(1, 0), I(1, 1), Ij.y(),
-              Ij.x(), Ij.y(), j_theta.dot(Ij);
-      Eigen::Matrix3d Hk = -qJ * qJ.transpose() + JtIJ;
-      Hk(2, 2) += iq.dot(h_theta);
-      out.hessian += e * Hk;
+      const double ijx = a00 * jx + a01 * jy, ijy = a01 * jx + a11 * jy;  // Σ⁻¹j_θ
+      H00 += e * (a00 - iqx * iqx);
+      H01 += e * (a01 - iqx * iqy);
+      H02 += e * (ijx - iqx * qj);
+      H11 += e * (a11 - iqy * iqy);
+      H12 += e * (ijy - iqy * qj);
+      H22 += e * (jx * ijx + jy * ijy - qj * qj + iqx * hx + iqy * hy);
     }
     if (matched) ++out.matched;
   }
+  out.h = h;
+  out.gradient << g0, g1, g2;
+  out.hessian << H00, H01, H02, H01, H11, H12, H02, H12, H22;
   return out;
 }
 
