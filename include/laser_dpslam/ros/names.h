@@ -7,6 +7,15 @@ namespace names {
 // Topics (relative: remap them in launch files).
 constexpr const char* kScanTopic = "scan";
 constexpr const char* kOdomTopic = "odom";
+constexpr const char* kMapTopic = "map";
+constexpr const char* kMapMetadataTopic = "map_metadata";
+constexpr const char* kPoseTopic = "pose";
+constexpr const char* kTrajectoryTopic = "trajectory";
+constexpr const char* kParticlesTopic = "particles";
+
+// Services.
+constexpr const char* kDynamicMapService = "dynamic_map";
+constexpr const char* kSaveMapService = "save_map";
 
 // Default frames (REP-105); each node has a parameter to change them.
 constexpr const char* kOdomFrame = "odom";
