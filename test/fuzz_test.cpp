@@ -1,0 +1,95 @@
+// Fuzz: 10^5 randomly malformed scans through preprocessing → laser odometry (issue 6). Nothing may
+// crash or throw, and no pose, covariance or velocity may ever be non-finite.
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+#include "laser_dpslam/laser_odometry.h"
+#include "laser_dpslam/scan_preprocessor.h"
+
+using namespace laser_dpslam;
+
+namespace {
+
+float pick(std::mt19937_64& rng) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  std::uniform_real_distribution<float> range(0.0f, 6.0f);
+  switch (rng() % 10) {
+    case 0: return nan;
+    case 1: return inf;
+    case 2: return -inf;
+    case 3: return -range(rng);
+    case 4: return 1e30f;
+    case 5: return 0.0f;
+    case 6: return std::numeric_limits<float>::denorm_min();
+    default: return range(rng);
+  }
+}
+
+double pickField(std::mt19937_64& rng, double sane) {
+  switch (rng() % 12) {
+    case 0: return std::numeric_limits<double>::quiet_NaN();
+    case 1: return std::numeric_limits<double>::infinity();
+    case 2: return -sane;
+    case 3: return 0.0;
+    case 4: return 1e12;
+    default: return sane;
+  }
+}
+
+LaserScan randomScan(std::mt19937_64& rng, double stamp) {
+  LaserScan s;
+  s.stamp = stamp;
+  s.frame_id = "laser";
+  const std::size_t n = rng() % 4 == 0 ? rng() % 8 : 100 + rng() % 700;  // empty, tiny or ordinary
+  s.angle_min = pickField(rng, -2.09);
+  s.angle_increment = pickField(rng, 0.00614);
+  s.angle_max = rng() % 5 == 0 ? pickField(rng, -3.0) : s.angle_min + s.angle_increment * (n ? n - 1 : 0);
+  s.range_min = pickField(rng, 0.02);
+  s.range_max = pickField(rng, 5.6);
+  s.ranges.resize(n);
+  // Mostly-plausible scans: a room-like shape with garbage sprinkled in, so the matcher is exercised.
+  const bool structured = rng() % 2 == 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    s.ranges[i] = structured && rng() % 8 != 0 ? 2.0f + 0.5f * std::sin(0.02f * i) : pick(rng);
+  }
+  s.intensities.resize(rng() % 3 == 0 ? rng() % 50 : 0);
+  return s;
+}
+
+}  // namespace
+
+TEST(Fuzz, MalformedScansNeverCrashOrPoisonTheOdometry) {
+  std::mt19937_64 rng(20261122);
+  LaserOdometryConfig config;
+  config.matcher.de_generations = 5;  // keep the run short: the matcher's inputs are what is fuzzed
+  LaserOdometry odometry(config);
+  double stamp = 1000.0;
+  int processed = 0, rejected = 0, matched = 0;
+  for (int i = 0; i < 100000; ++i) {
+    // Time mostly moves on, sometimes repeats, jumps back (bag loop) or leaps forward.
+    const auto r = rng() % 50;
+    stamp += r == 0 ? -30.0 : r == 1 ? 0.0 : r == 2 ? 500.0 : 0.1;
+    const LaserScan scan = randomScan(rng, stamp);
+    PreprocessedScan pre;
+    ASSERT_NO_THROW(pre = preprocessScan(scan, ScanPreprocessorConfig())) << "scan " << i;
+    for (const auto& p : pre.points) ASSERT_TRUE(p.allFinite()) << "scan " << i;
+    if (!pre.ok()) ++rejected;
+    const LaserMount mount = LaserMount::fromPose(Pose2D(0.1, 0.0, 0.0));
+    OdometryUpdate u;
+    ASSERT_NO_THROW(u = odometry.process(pre, mount)) << "scan " << i;
+    ASSERT_TRUE(u.pose.vector().allFinite()) << "scan " << i;
+    ASSERT_TRUE(u.pose_covariance.allFinite()) << "scan " << i;
+    ASSERT_TRUE(u.delta_covariance.allFinite()) << "scan " << i;
+    ASSERT_TRUE(u.velocity.allFinite()) << "scan " << i;
+    ++processed;
+    if (u.ok && u.match.valid) ++matched;
+  }
+  EXPECT_EQ(processed, 100000);
+  // The fuzzer must reach both the rejection paths and the matcher, or it tests nothing.
+  EXPECT_GT(rejected, 10000);
+  EXPECT_GT(matched, 1000);
+  RecordProperty("rejected", rejected);
+  RecordProperty("matched", matched);
+}
