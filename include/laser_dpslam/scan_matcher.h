@@ -36,7 +36,7 @@ struct ScanMatcherConfig {
 
   // Newton polish on h (algorithms.md §2).
   int newton_iterations = 10;         ///< per resolution
-  double newton_tolerance = 1e-4;     ///< m / rad, step size at which Newton stops
+  double newton_tolerance = 1e-5;     ///< m / rad, step size at which Newton stops
 
   // Covariance and quality.
   double covariance_scale = 4.0;        ///< α in Σ = α·H⁻¹ + Σ_min (h is not a normalised likelihood)

@@ -49,9 +49,6 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
       delta = -H.ldlt().solve(s.gradient);
     }
     if (!delta.allFinite()) break;
-    // Converged: a step this small changes nothing that matters (and near the optimum the score's
-    // rounding noise would only make the line search fail repeatedly).
-    if (delta.head<2>().norm() < config_.newton_tolerance && std::abs(delta.z()) < config_.newton_tolerance) break;
     // Backtracking: a Newton step on a sum of Gaussians can overshoot.
     double step = 1.0;
     bool improved = false;
@@ -68,6 +65,11 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
       step *= 0.5;
     }
     if (!improved) break;
+    if ((step * delta).head<2>().norm() < config_.newton_tolerance &&
+        std::abs(step * delta.z()) < config_.newton_tolerance) {
+      ++it;
+      break;
+    }
   }
   if (iterations) *iterations += it;
   return pose;
