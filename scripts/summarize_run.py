@@ -28,7 +28,15 @@ def main():
              stats["odometry_ms"]["median"], stats["odometry_ms"]["p95"]))
     print("weak or degenerate matches: %.1f %%; skipped: %s" % (stats["bad_match_percent"], stats["skipped"] or "none"))
     if truth and os.path.exists(truth):
-        t, x, y, th = load_tum(os.path.join(out, "odometry.tum"))
+        for name in ("odometry.tum", "trajectory.tum"):
+            if os.path.exists(os.path.join(out, name)):
+                report(os.path.join(out, name), truth)
+    print("outputs in %s%s" % (out, " (map: %s)" % os.path.join(out, "map.png") if os.path.exists(os.path.join(out, "map.png")) else ""))
+
+
+def report(estimate, truth):
+    if True:
+        t, x, y, th = load_tum(estimate)
         gt, gx, gy, gth = load_tum(truth)
         ex, ey, eth = relative_to_first(x, y, th)
         # Ground truth at the estimate's stamps (the simulator writes one pose per scan).
@@ -36,11 +44,11 @@ def main():
         rx, ry, rth = relative_to_first(gx[ix], gy[ix], gth[ix])
         err = np.hypot(ex - rx, ey - ry)
         dist = np.sum(np.hypot(np.diff(rx), np.diff(ry)))
-        print("laser odometry vs ground truth: final error %.3f m (%.2f %% of %.1f m travelled), "
-              "max %.3f m, final heading error %.2f deg"
-              % (err[-1], 100.0 * err[-1] / max(dist, 1e-9), dist, err.max(),
+        label = "SLAM trajectory" if estimate.endswith("trajectory.tum") else "laser odometry"
+        print("%s vs ground truth (first poses aligned): RMSE %.3f m, final error %.3f m (%.2f %% of %.1f m "
+              "travelled), max %.3f m, final heading error %.2f deg"
+              % (label, math.sqrt(np.mean(err ** 2)), err[-1], 100.0 * err[-1] / max(dist, 1e-9), dist, err.max(),
                  math.degrees(abs(math.atan2(math.sin(eth[-1] - rth[-1]), math.cos(eth[-1] - rth[-1]))))))
-    print("outputs in %s" % out)
 
 
 if __name__ == "__main__":
