@@ -13,12 +13,16 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <sys/stat.h>
 #include <vector>
 
+#include "laser_dpslam/dpslam.h"
+#include "laser_dpslam/dpslam_parameters.h"
 #include "laser_dpslam/laser_odometry.h"
+#include "laser_dpslam/occupancy_export.h"
 #include "laser_dpslam/odometry_parameters.h"
 #include "laser_dpslam/parameter_source.h"
 #include "laser_dpslam/ros/bag_tf.h"
@@ -108,19 +112,24 @@ void progress(std::size_t done, std::size_t total) {
 int main(int argc, char** argv) {
   const Args args = parseArgs(argc, argv);
 
+  // One flat parameter namespace: a --config file may hold odometry and SLAM parameters alike
+  // (config/laser_odometry.yaml, config/dpslam.yaml); later files override earlier ones.
   LaserOdometryConfig odom_config;
   ScanPreprocessorConfig pre_config;
+  DpSlamConfig slam_config;
   try {
     for (const auto& path : args.configs) {
-      readOdometryParameters(YamlParameterSource::load(path), odom_config, pre_config);
+      const YamlParameterSource source = YamlParameterSource::load(path);
+      readOdometryParameters(source, odom_config, pre_config);
+      readDpSlamParameters(source, slam_config);
     }
+    if (args.has_seed) {
+      odom_config.seed = static_cast<std::uint64_t>(args.seed);
+      slam_config.seed = static_cast<std::uint64_t>(args.seed);
+    }
+    slam_config.validate();
   } catch (const std::exception& e) {
     std::cerr << "dpslam_offline: " << e.what() << "\n";
-    return 2;
-  }
-  if (args.has_seed) odom_config.seed = static_cast<std::uint64_t>(args.seed);
-  if (!args.odometry_only) {
-    std::cerr << "dpslam_offline: the DP-SLAM stage is not built yet; run with --odometry-only\n";
     return 2;
   }
 
@@ -160,6 +169,13 @@ int main(int argc, char** argv) {
   const bool show_progress = !args.quiet && ::isatty(STDOUT_FILENO);
   std::string match_log = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt\n";
   LaserOdometry odometry(odom_config);
+  std::unique_ptr<DpSlam> slam;
+  if (!args.odometry_only) slam = std::make_unique<DpSlam>(slam_config);
+  Pose2D slam_last_odom;               // odometry pose of the last scan given to the SLAM
+  Eigen::Matrix3d slam_delta_cov = Eigen::Matrix3d::Zero();  // accumulated since then
+  bool slam_has_last = false;
+  std::vector<double> slam_ms;
+  DpSlamUpdate last_slam;
   LaserMount mount;
   bool mount_known = false;
   std::string laser_frame;
@@ -233,6 +249,19 @@ int main(int argc, char** argv) {
     }
     odom_poses.push_back({scan.stamp, u.pose});
     last_stamp = scan.stamp;
+    if (slam) {
+      if (u.reset && slam_has_last) slam->reset();  // the odometry restarted: so does the map
+      slam_delta_cov += u.delta_covariance;
+      const Pose2D delta = slam_has_last && !u.reset ? between(slam_last_odom, u.pose) : Pose2D();
+      const auto s0 = std::chrono::steady_clock::now();
+      last_slam = slam->process(scan.stamp, pre, mount, delta, slam_delta_cov);
+      // Wall time: the SLAM scores particles on several threads.
+      slam_ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count());
+      if (!last_slam.ok) ++skipped["slam_" + last_slam.skip_reason];
+      slam_last_odom = u.pose;
+      slam_delta_cov.setZero();
+      slam_has_last = true;
+    }
     if (show_progress && done % 20 == 0) progress(done, total);
   }
   if (show_progress) {
@@ -245,6 +274,13 @@ int main(int argc, char** argv) {
 
   try {
     writeFileAtomically(args.out + "/odometry.tum", formatTum(odom_poses));
+    if (slam) {
+      const std::vector<StampedPose> trajectory = slam->bestTrajectory();
+      const OccupancyGridData grid = slam->bestMap();
+      writeFileAtomically(args.out + "/trajectory.tum", formatTum(trajectory));
+      writeMapServerFiles(grid, args.out + "/map.yaml");
+      writeMapPng(grid, trajectory, args.out + "/map.png");
+    }
     if (!args.match_log.empty()) writeFileAtomically(args.match_log, match_log);
     std::string json = "{\n";
     json += "  \"scans\": " + std::to_string(total) + ",\n";
@@ -253,13 +289,18 @@ int main(int argc, char** argv) {
     json += "  \"cpu_s\": " + jsonNumber(cpu) + ",\n";
     json += "  \"realtime_factor\": " + jsonNumber(wall > 0 ? duration / wall : 0.0) + ",\n";
     json += "  \"odometry_ms\": " + jsonTiming(summarize(odom_ms)) + ",\n";
-    json += "  \"slam_ms\": null,\n";
+    json += "  \"slam_ms\": " + (slam ? jsonTiming(summarize(slam_ms)) : std::string("null")) + ",\n";
     json += "  \"peak_rss_mb\": " + jsonNumber(peakRssMb()) + ",\n";
-    json += "  \"particles\": 0,\n";
+    json += "  \"particles\": " + std::to_string(slam ? slam_config.particles : 0) + ",\n";
+    if (slam) {
+      json += "  \"tree_nodes\": " + std::to_string(last_slam.tree_nodes) + ",\n";
+      json += "  \"map_entries\": " + std::to_string(last_slam.map_entries) + ",\n";
+      json += "  \"slam_memory_mb\": " + jsonNumber(last_slam.memory_bytes / 1048576.0) + ",\n";
+    }
     json += "  \"seed\": " + std::to_string(odom_config.seed) + ",\n";
     json += "  \"bad_match_percent\": " + jsonNumber(matched ? 100.0 * bad / matched : 0.0) + ",\n";
     json += "  \"resampling\": " + jsonString(resamplingMethodName(odom_config.resampling)) + ",\n";
-    json += "  \"mode\": \"odometry-only\",\n";
+    json += std::string("  \"mode\": ") + (slam ? "\"slam\"" : "\"odometry-only\"") + ",\n";
     json += "  \"skipped\": " + jsonCounts(skipped) + "\n}\n";
     writeFileAtomically(args.out + "/stats.json", json);
   } catch (const std::exception& e) {

@@ -1,0 +1,152 @@
+// DP-SLAM on top of the laser odometry (the thesis's "scan-matching motion model"): particles move by
+// the scan-match delta plus noise drawn from its covariance, are weighted by the laser-penetration model
+// against their own maps (one shared DpSlamMap with an ancestry tree), and are resampled when the
+// effective sample size drops. The facade the offline tool and the node call. No ROS.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "laser_dpslam/ancestry_tree.h"
+#include "laser_dpslam/dpslam_map.h"
+#include "laser_dpslam/laser_mount.h"
+#include "laser_dpslam/occupancy_export.h"
+#include "laser_dpslam/particle_filter.h"
+#include "laser_dpslam/pose2d.h"
+#include "laser_dpslam/scan_preprocessor.h"
+#include "laser_dpslam/trajectory_io.h"
+
+namespace laser_dpslam {
+
+class WorkerPool;
+
+/// Every SLAM parameter; names, units and defaults are mirrored in config/dpslam.yaml.
+struct DpSlamConfig {
+  // --- Particle filter ---
+  int particles = 30;               ///< P
+  int oversampling = 1;             ///< candidate poses drawn per particle; the best by the cheap score is kept (1 = off)
+  double cull_window = 0.25;        ///< m, half-width around each measured range traced by the cheap score
+  double resample_threshold = 0.5;  ///< resample when Neff < this × P (1 = every update)
+  int refine_iterations = 0;        ///< improved proposal: hill-climbing steps of each particle on its own map (0 = off)
+  double refine_step_xy = 0.02;     ///< m, first step of the hill climb
+  double refine_step_theta = 0.005; ///< rad, first step of the hill climb
+  int refine_halvings = 3;          ///< the climb stops after halving its steps this many times
+  ProposalNoise proposal;           ///< noise added to the scan-match delta (see ProposalNoise)
+  double min_travel_distance = 0.0;  ///< m; the filter updates once the robot moved this far ...
+  double min_travel_angle = 0.0;     ///< rad; ... or turned this much since its last update (0 and 0 = every scan)
+  // --- Map ---
+  double map_resolution = 0.05;    ///< m per cell
+  double trace_max_range = 20.0;   ///< m; beams are traced this far at most, longer returns count as free space
+  double no_return_range = 6.0;    ///< m; a no-return beam is free space up to min(this, the scan's range_max)
+  double entry_prior_cells = 4.0;  ///< cells of distance a new cell entry starts with (DP-SLAM's prior)
+  int update_beam_step = 1;        ///< every k-th beam is written into the map
+  double free_saturation_distance = 1.0;  ///< m; free cells seen without a hit over this distance are not rewritten (0 = off)
+  double map_update_distance = 0.0;  ///< m travelled since the last map update before the next ...
+  double map_update_angle = 0.0;     ///< rad turned since the last map update (0 and 0 = every filter update)
+  // --- Observation model ---
+  BeamModelConfig beam;         ///< sigma, window, log floor, unknown mean free path
+  int score_beam_step = 4;      ///< every k-th beam is scored (tempering and speed)
+  bool score_no_return = true;  ///< no-return beams are scored too (free space up to the range)
+  int min_points = 20;          ///< fewer valid returns: the scan is not used (particles still move)
+  // --- Output ---
+  double occupancy_stop_length = 0.1;  ///< m; occupancy = 1 − exp(−density · this)
+  std::uint64_t seed = 1;              ///< random seed (same seed and input → same output)
+  int threads = 2;                     ///< worker threads for scoring (results do not depend on it)
+
+  /// Throws std::invalid_argument naming the first impossible value.
+  void validate() const;
+};
+
+struct DpSlamUpdate {
+  bool ok = false;               ///< false: the scan was not used (skip_reason); particles still moved
+  std::string skip_reason;       ///< "malformed_scan", "too_few_points"
+  double stamp = 0.0;
+  Pose2D pose;                   ///< best particle, map → base_link
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< weighted spread of the particles (x, y, θ)
+  bool filter_updated = false;   ///< weights updated (false while below the minimum travel)
+  bool map_updated = false;
+  bool resampled = false;
+  double neff = 0.0;             ///< effective sample size after the update
+  double score_spread = 0.0;     ///< best − worst log-likelihood of this scan over the particles (weight peakiness)
+  std::size_t tree_nodes = 0;
+  std::size_t map_entries = 0;
+  std::size_t memory_bytes = 0;  ///< map + caches
+};
+
+class DpSlam {
+ public:
+  explicit DpSlam(const DpSlamConfig& config = DpSlamConfig());
+  ~DpSlam();
+  DpSlam(const DpSlam&) = delete;
+  DpSlam& operator=(const DpSlam&) = delete;
+
+  /// One scan. `delta`/`delta_cov`: the laser odometry's motion since the previous call (in the previous
+  /// base frame) and its covariance; ignored on the first scan, which defines the map frame (= the base
+  /// frame at that scan). Skipped scans still move the particles by `delta`.
+  DpSlamUpdate process(double stamp, const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& delta,
+                       const Eigen::Matrix3d& delta_cov);
+  void reset();
+
+  bool initialized() const { return initialized_; }
+  Pose2D bestPose() const;
+  /// The best particle's whole path: one pose per process() call since the first used scan.
+  std::vector<StampedPose> bestTrajectory() const;
+  OccupancyGridData bestMap() const;
+  std::vector<Pose2D> particlePoses() const;
+  std::vector<double> logWeights() const { return logw_; }
+
+  const DpSlamConfig& config() const { return config_; }
+  const DpSlamMap& map() const { return map_; }
+  const AncestryTree& tree() const { return tree_; }
+  std::size_t memoryBytes() const;
+
+ private:
+  struct BaseBeam {
+    double dx, dy;  ///< unit direction in the base frame
+    double range;   ///< m
+    bool no_return;
+  };
+  void makeBeams(const PreprocessedScan& scan, const LaserMount& mount);
+  MapBeam toMap(const Pose2D& pose, const BaseBeam& b) const;
+  double score(const Pose2D& pose, int slot, LookupCache& cache) const;
+  double cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const;
+  /// Hill climb of the cheap score from `start` (steps along the particle's own axes).
+  Pose2D refine(const Pose2D& start, int slot, LookupCache& cache) const;
+  /// Plans the scan writes of `who` (old particles, at `at`, seen through the scoring caches) in parallel.
+  void planWrites(const std::vector<int>& who, const std::vector<Pose2D>& at);
+  /// Applies the planned writes of who[s] under nodes[s] (single-threaded, in order).
+  void applyWrites(const std::vector<int>& who, const std::vector<int>& nodes);
+  void filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d& cov, DpSlamUpdate& u);
+  void record(double stamp);
+  void fill(DpSlamUpdate& u) const;
+
+  DpSlamConfig config_;
+  std::unique_ptr<WorkerPool> pool_;
+  std::vector<LookupCache> caches_;  ///< one per worker (scoring)
+  LookupCache update_cache_;
+  std::vector<std::vector<DpSlamMap::CellWrite>> writes_;  ///< per particle, reused
+  GaussianSampler rng_;
+  AncestryTree tree_;
+  DpSlamMap map_;
+
+  bool initialized_ = false;
+  int generation_ = 0;
+  std::vector<Pose2D> poses_;   ///< particle poses at their last filter update
+  std::vector<int> leaves_;     ///< ancestry node of each particle
+  std::vector<double> logw_;
+  int best_ = 0;
+  double last_neff_ = 0.0;
+  Pose2D pending_;              ///< odometry motion since the last filter update (base frame then)
+  Eigen::Matrix3d pending_cov_ = Eigen::Matrix3d::Zero();
+  Pose2D since_map_update_;     ///< filter motion since the last map update
+  bool force_map_update_ = false;
+
+  Eigen::Vector2d beam_origin_ = Eigen::Vector2d::Zero();  ///< laser position in the base frame
+  std::vector<BaseBeam> score_beams_, update_beams_;
+};
+
+}  // namespace laser_dpslam

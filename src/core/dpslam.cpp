@@ -1,0 +1,399 @@
+#include "laser_dpslam/dpslam.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "laser_dpslam/worker_pool.h"
+
+namespace laser_dpslam {
+
+namespace {
+void require(bool ok, const char* what) {
+  if (!ok) throw std::invalid_argument(std::string("DpSlamConfig: ") + what);
+}
+
+/// a ⊕ b and the first-order covariance of the composition.
+void compose(Pose2D& a, Eigen::Matrix3d& cov_a, const Pose2D& b, const Eigen::Matrix3d& cov_b) {
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  Eigen::Matrix3d ja = Eigen::Matrix3d::Identity(), jb = Eigen::Matrix3d::Identity();
+  ja(0, 2) = -s * b.x - c * b.y;
+  ja(1, 2) = c * b.x - s * b.y;
+  jb(0, 0) = c;
+  jb(0, 1) = -s;
+  jb(1, 0) = s;
+  jb(1, 1) = c;
+  cov_a = ja * cov_a * ja.transpose() + jb * cov_b * jb.transpose();
+  a = a * b;
+}
+}  // namespace
+
+void DpSlamConfig::validate() const {
+  require(particles >= 1, "particles must be >= 1");
+  require(oversampling >= 1, "oversampling must be >= 1");
+  require(cull_window > 0.0, "cull_window must be > 0");
+  require(refine_iterations >= 0 && refine_halvings >= 0, "refine_iterations and refine_halvings must be >= 0");
+  require(refine_step_xy > 0.0 && refine_step_theta > 0.0, "refine steps must be > 0");
+  require(resample_threshold >= 0.0 && resample_threshold <= 1.0, "resample_threshold must be in [0, 1]");
+  require(proposal.covariance_scale >= 0.0, "proposal_covariance_scale must be >= 0");
+  require(proposal.min_sigma_xy >= 0.0 && proposal.min_sigma_theta >= 0.0, "proposal minimum sigmas must be >= 0");
+  require(proposal.sigma_xy_per_m >= 0.0 && proposal.sigma_theta_per_rad >= 0.0, "proposal sigma rates must be >= 0");
+  require(min_travel_distance >= 0.0 && min_travel_angle >= 0.0, "minimum travel must be >= 0");
+  require(map_resolution > 0.0, "map_resolution must be > 0");
+  require(trace_max_range > map_resolution, "trace_max_range must exceed map_resolution");
+  require(no_return_range > 0.0, "no_return_range must be > 0");
+  require(entry_prior_cells > 0.0, "entry_prior_cells must be > 0");
+  require(update_beam_step >= 1 && score_beam_step >= 1, "beam steps must be >= 1");
+  require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
+  require(map_update_distance >= 0.0 && map_update_angle >= 0.0, "map update thresholds must be >= 0");
+  require(beam.sigma > 0.0, "beam_sigma must be > 0");
+  require(beam.window > 0.0, "beam_window must be > 0");
+  require(beam.log_floor < 0.0, "beam_log_floor must be < 0");
+  require(beam.unknown_mean_free_path > 0.0, "unknown_mean_free_path must be > 0");
+  require(min_points >= 1, "slam_min_points must be >= 1");
+  require(occupancy_stop_length > 0.0, "occupancy_stop_length must be > 0");
+  require(threads >= 1, "threads must be >= 1");
+}
+
+DpSlam::DpSlam(const DpSlamConfig& config)
+    : config_(config), rng_(config.seed), map_(config.map_resolution, config.entry_prior_cells) {
+  config_.validate();
+  pool_.reset(new WorkerPool(config_.threads));
+  caches_.resize(static_cast<std::size_t>(config_.threads));
+}
+
+DpSlam::~DpSlam() = default;
+
+void DpSlam::reset() {
+  tree_.clear();
+  map_.clear();
+  rng_.seed(config_.seed);
+  initialized_ = false;
+  generation_ = 0;
+  poses_.clear();
+  leaves_.clear();
+  logw_.clear();
+  best_ = 0;
+  last_neff_ = 0.0;
+  pending_ = Pose2D();
+  pending_cov_.setZero();
+  since_map_update_ = Pose2D();
+  force_map_update_ = false;
+}
+
+void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
+  beam_origin_ = mount.t;
+  const double no_return_range = std::min(config_.no_return_range, scan.range_max > 0.0 ? scan.range_max : config_.no_return_range);
+  std::vector<BaseBeam> all;
+  all.reserve(scan.points.size() + scan.no_return_angles.size());
+  // Returns and no-returns in beam-angle order, so that "every k-th beam" spreads over the whole scan.
+  std::size_t i = 0, j = 0;
+  while (i < scan.points.size() || j < scan.no_return_angles.size()) {
+    const bool take_return =
+        j >= scan.no_return_angles.size() || (i < scan.points.size() && scan.angles[i] <= scan.no_return_angles[j]);
+    const double a = take_return ? scan.angles[i] : scan.no_return_angles[j];
+    const Eigen::Vector2d d = mount.A * Eigen::Vector2d(std::cos(a), std::sin(a));
+    const double n = d.norm();
+    BaseBeam b{d.x() / n, d.y() / n, 0.0, !take_return};
+    if (take_return) {
+      b.range = scan.ranges[i++];
+    } else {
+      b.range = no_return_range;
+      ++j;
+      if (!config_.score_no_return) b.range = -1.0;  // marker: written, not scored
+    }
+    all.push_back(b);
+  }
+  score_beams_.clear();
+  update_beams_.clear();
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    BaseBeam b = all[k];
+    const bool scored_out = b.range < 0.0;
+    if (scored_out) b.range = no_return_range;
+    if (k % static_cast<std::size_t>(config_.update_beam_step) == 0) update_beams_.push_back(b);
+    if (!scored_out && k % static_cast<std::size_t>(config_.score_beam_step) == 0) score_beams_.push_back(b);
+  }
+}
+
+MapBeam DpSlam::toMap(const Pose2D& pose, const BaseBeam& b) const {
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  MapBeam m;
+  m.ox = pose.x + c * beam_origin_.x() - s * beam_origin_.y();
+  m.oy = pose.y + s * beam_origin_.x() + c * beam_origin_.y();
+  m.dx = c * b.dx - s * b.dy;
+  m.dy = s * b.dx + c * b.dy;
+  m.range = b.range;
+  m.no_return = b.no_return;
+  return m;
+}
+
+double DpSlam::score(const Pose2D& pose, int slot, LookupCache& cache) const {
+  double sum = 0.0;
+  for (const BaseBeam& b : score_beams_) {
+    sum += map_.beamLogLikelihood(toMap(pose, b), config_.trace_max_range, slot, cache, config_.beam);
+  }
+  return sum;
+}
+
+double DpSlam::cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const {
+  double sum = 0.0;
+  for (const BaseBeam& b : score_beams_) {
+    if (b.no_return || b.range >= config_.trace_max_range) continue;
+    sum += map_.beamEndpointLogLikelihood(toMap(pose, b), config_.cull_window, slot, cache, config_.beam);
+  }
+  return sum;
+}
+
+Pose2D DpSlam::refine(const Pose2D& start, int slot, LookupCache& cache) const {
+  Pose2D x = start;
+  double best = cheapScore(x, slot, cache);
+  double sxy = config_.refine_step_xy, sth = config_.refine_step_theta;
+  int halvings = 0;
+  for (int it = 0; it < config_.refine_iterations; ++it) {
+    const Pose2D moves[6] = {Pose2D(sxy, 0, 0), Pose2D(-sxy, 0, 0), Pose2D(0, sxy, 0),
+                             Pose2D(0, -sxy, 0), Pose2D(0, 0, sth),  Pose2D(0, 0, -sth)};
+    Pose2D bx = x;
+    bool improved = false;
+    for (const Pose2D& m : moves) {
+      const Pose2D c = x * m;
+      const double v = cheapScore(c, slot, cache);
+      if (v > best) {
+        best = v;
+        bx = c;
+        improved = true;
+      }
+    }
+    if (improved) {
+      x = bx;
+    } else {
+      if (++halvings > config_.refine_halvings) break;
+      sxy *= 0.5;
+      sth *= 0.5;
+    }
+  }
+  return x;
+}
+
+void DpSlam::planWrites(const std::vector<int>& who, const std::vector<Pose2D>& at) {
+  writes_.resize(std::max(writes_.size(), at.size()));
+  pool_->run(who.size(), [&](std::size_t k, int w) {
+    const int i = who[k];
+    writes_[i].clear();
+    for (const BaseBeam& b : update_beams_) {
+      map_.planBeam(toMap(at[i], b), config_.trace_max_range, i, caches_[w], config_.free_saturation_distance, writes_[i]);
+    }
+  });
+}
+
+void DpSlam::applyWrites(const std::vector<int>& who, const std::vector<int>& nodes) {
+  update_cache_.begin(tree_, nodes);
+  for (std::size_t s = 0; s < who.size(); ++s) {
+    map_.applyWrites(writes_[who[s]], static_cast<int>(s), nodes[s], update_cache_, config_.free_saturation_distance);
+  }
+}
+
+void DpSlam::record(double stamp) {
+  for (std::size_t j = 0; j < poses_.size(); ++j) {
+    StampedPose sp;
+    sp.stamp = stamp;
+    sp.pose = poses_[j] * pending_;
+    tree_.node(leaves_[j]).path.push_back(sp);
+  }
+}
+
+DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& delta,
+                             const Eigen::Matrix3d& delta_cov) {
+  DpSlamUpdate u;
+  u.stamp = stamp;
+  if (!scan.ok()) {
+    u.skip_reason = "malformed_scan";
+  } else if (static_cast<int>(scan.points.size()) < config_.min_points) {
+    u.skip_reason = "too_few_points";
+  }
+  const bool usable = u.skip_reason.empty();
+
+  if (!initialized_) {
+    if (!usable) {
+      fill(u);
+      return u;
+    }
+    makeBeams(scan, mount);
+    const int P = config_.particles;
+    const int root = tree_.createRoot(0);
+    poses_.assign(P, Pose2D());
+    logw_.assign(P, 0.0);
+    leaves_ = {root};
+    poses_.resize(1);
+    record(stamp);
+    for (auto& c : caches_) c.begin(tree_, leaves_);
+    planWrites({0}, poses_);
+    applyWrites({0}, {root});
+    leaves_ = tree_.advance({root}, std::vector<int>(P, 0), ++generation_, map_);
+    poses_.assign(P, Pose2D());
+    best_ = 0;
+    last_neff_ = P;
+    initialized_ = true;
+    u.ok = true;
+    u.map_updated = true;
+    fill(u);
+    return u;
+  }
+
+  compose(pending_, pending_cov_, delta, delta_cov);
+  const bool moved_enough = (config_.min_travel_distance <= 0.0 && config_.min_travel_angle <= 0.0) ||
+                            std::hypot(pending_.x, pending_.y) >= config_.min_travel_distance ||
+                            std::abs(pending_.theta) >= config_.min_travel_angle;
+  if (!usable || !moved_enough) {
+    // Not weighted: the particles carry the motion forward (and its uncertainty) until a usable scan.
+    record(stamp);
+    u.ok = usable;
+    fill(u);
+    return u;
+  }
+  makeBeams(scan, mount);
+  filterStep(stamp, pending_, pending_cov_, u);
+  u.ok = true;
+  fill(u);
+  return u;
+}
+
+void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d& cov, DpSlamUpdate& u) {
+  const int P = config_.particles;
+  const int K = config_.oversampling;
+  // 1. Proposal: each particle moves by the delta plus noise, in its own frame. Draws in a fixed order.
+  const Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal);
+  std::vector<Pose2D> chosen(P);
+  std::vector<double> ll(P);
+  for (auto& c : caches_) c.begin(tree_, leaves_);
+  if (config_.refine_iterations > 0) {
+    // Improved proposal: each particle climbs to the best fit of the scan on its own map from pose ⊕ delta,
+    // is weighted there (so the noise below does not make the weights peaky), and then moves by noise
+    // drawn from the proposal's covariance around that fit.
+    std::vector<Pose2D> noise(P);
+    for (int i = 0; i < P; ++i) noise[i] = sampleMotion(Pose2D(), L, rng_);
+    pool_->run(P, [&](std::size_t i, int w) {
+      const Pose2D fit = refine(poses_[i] * delta, static_cast<int>(i), caches_[w]);
+      ll[i] = score(fit, static_cast<int>(i), caches_[w]);
+      chosen[i] = fit * noise[i];
+    });
+  } else {
+    std::vector<Pose2D> candidates(static_cast<std::size_t>(P) * K);
+    for (int i = 0; i < P; ++i) {
+      for (int k = 0; k < K; ++k) candidates[static_cast<std::size_t>(i) * K + k] = poses_[i] * sampleMotion(delta, L, rng_);
+    }
+    // 2. Over-sampling: keep each particle's best candidate by the cheap endpoint score.
+    if (K > 1) {
+      std::vector<double> cheap(candidates.size());
+      pool_->run(candidates.size(), [&](std::size_t n, int w) {
+        cheap[n] = cheapScore(candidates[n], static_cast<int>(n / K), caches_[w]);
+      });
+      for (int i = 0; i < P; ++i) {
+        int best = 0;
+        for (int k = 1; k < K; ++k) {
+          if (cheap[static_cast<std::size_t>(i) * K + k] > cheap[static_cast<std::size_t>(i) * K + best]) best = k;
+        }
+        chosen[i] = candidates[static_cast<std::size_t>(i) * K + best];
+      }
+    } else {
+      chosen = candidates;
+    }
+    // 3. Weights: the full observation model, one result per particle (independent of scheduling).
+    pool_->run(P, [&](std::size_t i, int w) { ll[i] = score(chosen[i], static_cast<int>(i), caches_[w]); });
+  }
+  for (int i = 0; i < P; ++i) logw_[i] += ll[i];
+  u.score_spread = *std::max_element(ll.begin(), ll.end()) - *std::min_element(ll.begin(), ll.end());
+  const NormalizedWeights nw = normalizeLogWeights(logw_);
+  // 4. Neff-gated low-variance resampling.
+  std::vector<int> parents(P);
+  const bool resample = nw.neff < config_.resample_threshold * P || config_.resample_threshold >= 1.0;
+  if (resample) {
+    parents = lowVarianceResample(nw.w, P, rng_.uniform());
+  } else {
+    for (int i = 0; i < P; ++i) parents[i] = i;
+  }
+  // 5. Map update, planned now (the scoring caches still describe the old particles): each surviving
+  //    lineage writes the scan once, from its pose, into the node it will own alone after the ancestry
+  //    update. Its descendants (all at that pose) see exactly what they would see had each written its own
+  //    copy, without the copies.
+  since_map_update_ = since_map_update_ * delta;
+  const bool due = (config_.map_update_distance <= 0.0 && config_.map_update_angle <= 0.0) ||
+                   std::hypot(since_map_update_.x, since_map_update_.y) >= config_.map_update_distance ||
+                   std::abs(since_map_update_.theta) >= config_.map_update_angle;
+  std::vector<int> survivors;
+  for (int i = 0; i < P; ++i) {
+    if (std::find(parents.begin(), parents.end(), i) != parents.end()) survivors.push_back(i);
+  }
+  if (due) planWrites(survivors, chosen);
+  // 6. Ancestry maintenance, new generation.
+  std::vector<int> lineage;
+  leaves_ = tree_.advance(leaves_, parents, ++generation_, map_, &lineage);
+  if (due) {
+    std::vector<int> nodes;
+    for (int i : survivors) nodes.push_back(lineage[i]);
+    applyWrites(survivors, nodes);
+    since_map_update_ = Pose2D();
+    u.map_updated = true;
+  }
+  std::vector<double> new_logw(P);
+  const double max_logw = logw_[nw.best];
+  best_ = 0;
+  for (int j = 0; j < P; ++j) {
+    poses_[j] = chosen[parents[j]];
+    new_logw[j] = resample ? 0.0 : logw_[parents[j]] - max_logw;
+  }
+  for (int j = 0; j < P; ++j) {
+    if (parents[j] == nw.best) {
+      best_ = j;
+      break;
+    }
+  }
+  logw_ = new_logw;
+  last_neff_ = resample ? P : nw.neff;
+  pending_ = Pose2D();
+  pending_cov_.setZero();
+  record(stamp);
+  u.filter_updated = true;
+  u.resampled = resample;
+}
+
+void DpSlam::fill(DpSlamUpdate& u) const {
+  if (initialized_) {
+    u.pose = bestPose();
+    std::vector<double> w = normalizeLogWeights(logw_).w;
+    std::vector<Pose2D> poses = particlePoses();
+    u.covariance = weightedPoseCovariance(poses, w);
+  }
+  u.neff = last_neff_;
+  u.tree_nodes = tree_.size();
+  u.map_entries = map_.entryCount();
+  u.memory_bytes = memoryBytes();
+}
+
+Pose2D DpSlam::bestPose() const { return initialized_ ? poses_[best_] * pending_ : Pose2D(); }
+
+std::vector<StampedPose> DpSlam::bestTrajectory() const {
+  return initialized_ ? tree_.fullPath(leaves_[best_]) : std::vector<StampedPose>();
+}
+
+OccupancyGridData DpSlam::bestMap() const {
+  if (!initialized_) {
+    OccupancyGridData g;
+    g.resolution = config_.map_resolution;
+    return g;
+  }
+  return occupancyFromMap(map_, tree_, leaves_[best_], config_.occupancy_stop_length);
+}
+
+std::vector<Pose2D> DpSlam::particlePoses() const {
+  std::vector<Pose2D> out(poses_.size());
+  for (std::size_t i = 0; i < poses_.size(); ++i) out[i] = poses_[i] * pending_;
+  return out;
+}
+
+std::size_t DpSlam::memoryBytes() const {
+  std::size_t b = map_.memoryBytes() + update_cache_.memoryBytes();
+  for (const auto& c : caches_) b += c.memoryBytes();
+  return b;
+}
+
+}  // namespace laser_dpslam

@@ -1,0 +1,346 @@
+#include "laser_dpslam/dpslam_map.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+
+using namespace laser_dpslam;
+
+namespace {
+
+struct Seen {
+  bool known = false;
+  float hits = 0.0f, distance = 0.0f;
+  bool operator==(const Seen& o) const { return known == o.known && hits == o.hits && distance == o.distance; }
+};
+Seen seen(const MapEntry* e) { return e ? Seen{true, e->hits, e->distance} : Seen{}; }
+
+// A random world: P particles that write random cells of a small area for many steps, with random
+// resampling through AncestryTree::advance (the map as hooks).
+struct World {
+  AncestryTree tree;
+  DpSlamMap map{0.1, 4.0};
+  std::vector<int> leaves;
+  std::mt19937_64 rng;
+  int P;
+  World(int particles, std::uint64_t seed) : rng(seed), P(particles) {
+    const int root = tree.createRoot();
+    for (int i = 0; i < 30; ++i) map.observe(i % 10, i / 10, root, tree, 0.05, i % 3 == 0);
+    leaves = tree.advance({root}, std::vector<int>(P, 0), 1, map);
+  }
+  void writeRandom(int n) {
+    for (int leaf : leaves) {
+      for (int k = 0; k < n; ++k) {
+        map.observe(static_cast<int>(rng() % 12) - 1, static_cast<int>(rng() % 12) - 1, leaf, tree,
+                    0.01 * (1 + rng() % 10), rng() % 4 == 0);
+      }
+    }
+  }
+  std::vector<int> randomParents() {
+    std::vector<int> p(P);
+    const int mode = static_cast<int>(rng() % 3);
+    for (int j = 0; j < P; ++j) p[j] = mode == 0 ? j : static_cast<int>(rng() % (mode == 1 ? P : std::max(1, P / 3)));
+    return p;
+  }
+};
+
+}  // namespace
+
+TEST(TraceCells, ChordsMatchDenseSamplingOfTheRay) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double res = 0.05;
+  for (int trial = 0; trial < 200; ++trial) {
+    const double ox = u(rng), oy = u(rng), a = M_PI * u(rng), len = 0.2 + 2.0 * (u(rng) + 1.0);
+    const double dx = std::cos(a), dy = std::sin(a);
+    std::vector<std::pair<std::pair<int, int>, double>> cells;
+    double t_prev = 0.0, total = 0.0;
+    traceCells(ox, oy, dx, dy, 0.0, len, res, [&](int ix, int iy, double t0, double t1) {
+      EXPECT_NEAR(t0, t_prev, 1e-9);
+      EXPECT_GT(t1, t0);
+      t_prev = t1;
+      total += t1 - t0;
+      cells.push_back({{ix, iy}, t1 - t0});
+      return true;
+    });
+    EXPECT_NEAR(total, len, 1e-9);
+    // Dense sampling: the length of the ray inside each cell.
+    std::map<std::pair<int, int>, double> dense;
+    const double step = 1e-5;
+    for (double t = 0.5 * step; t < len; t += step) {
+      dense[{static_cast<int>(std::floor((ox + dx * t) / res)), static_cast<int>(std::floor((oy + dy * t) / res))}] += step;
+    }
+    std::map<std::pair<int, int>, double> traced;
+    for (const auto& c : cells) traced[c.first] += c.second;
+    for (const auto& kv : dense) {
+      if (kv.second < 5e-5) continue;  // corner grazes
+      ASSERT_TRUE(traced.count(kv.first)) << "trial " << trial << " missed a cell";
+      EXPECT_NEAR(traced[kv.first], kv.second, 5e-5);
+    }
+    for (const auto& kv : traced) {
+      if (kv.second > 5e-5) {
+        EXPECT_TRUE(dense.count(kv.first)) << "trial " << trial << " visited a cell the ray does not cross";
+      }
+    }
+  }
+}
+
+TEST(DpSlamMap, EntriesFollowTheAncestry) {
+  AncestryTree tree;
+  DpSlamMap map(0.1, 4.0);
+  const int root = tree.createRoot();
+  map.observe(2, 3, root, tree, 0.1, false);
+  map.observe(2, 3, root, tree, 0.05, true);  // in place
+  int n = 0;
+  const MapEntry* e = map.cellEntries(2, 3, &n);
+  ASSERT_EQ(n, 1);
+  EXPECT_FLOAT_EQ(e->hits, 1.0f);
+  EXPECT_FLOAT_EQ(e->distance, 0.15f + 0.4f);  // prior: 4 cells of 0.1 m
+  const auto kids = tree.advance({root}, {0, 0}, 1, map);
+  EXPECT_EQ(seen(map.lookup(2, 3, kids[0], tree)), seen(e));
+  map.observe(2, 3, kids[0], tree, 0.1, false);  // a copy of the root's, plus the observation
+  e = map.cellEntries(2, 3, &n);
+  ASSERT_EQ(n, 2);
+  EXPECT_EQ(map.lookup(2, 3, kids[0], tree)->owner, kids[0]);
+  EXPECT_FLOAT_EQ(map.lookup(2, 3, kids[0], tree)->distance, 0.55f + 0.1f);
+  EXPECT_EQ(map.lookup(2, 3, kids[1], tree)->owner, root);  // sibling unaffected
+  EXPECT_FLOAT_EQ(map.lookup(2, 3, kids[1], tree)->distance, 0.55f);
+  EXPECT_EQ(map.lookup(9, 9, kids[1], tree), nullptr);
+  EXPECT_EQ(map.check(), "");
+}
+
+TEST(DpSlamMap, CachedLookupsEqualReferenceLookups) {
+  World w(9, 5);
+  for (int step = 2; step < 40; ++step) {
+    w.writeRandom(20);
+    w.leaves = w.tree.advance(w.leaves, w.randomParents(), step, w.map);
+    LookupCache cache;
+    cache.begin(w.tree, w.leaves);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int s = 0; s < w.P; ++s) {
+        for (int y = -1; y < 11; ++y) {
+          for (int x = -1; x < 11; ++x) {
+            ASSERT_EQ(seen(w.map.cachedLookup(x, y, s, cache)), seen(w.map.lookup(x, y, w.leaves[s], w.tree)));
+          }
+        }
+      }
+    }
+  }
+}
+
+// Pruning and collapsing change who owns what, never what a surviving particle sees.
+TEST(DpSlamMap, AdvanceKeepsSurvivorsLookupsUnchanged) {
+  World w(12, 7);
+  for (int step = 2; step < 200; ++step) {
+    w.writeRandom(15);
+    const std::vector<int> parents = w.randomParents();
+    std::vector<std::vector<Seen>> before(w.P);
+    for (int j = 0; j < w.P; ++j) {
+      for (int y = -1; y < 11; ++y) {
+        for (int x = -1; x < 11; ++x) before[j].push_back(seen(w.map.lookup(x, y, w.leaves[parents[j]], w.tree)));
+      }
+    }
+    w.leaves = w.tree.advance(w.leaves, parents, step, w.map);
+    ASSERT_EQ(w.map.check(), "") << "step " << step;
+    ASSERT_EQ(w.tree.check(2), "") << "step " << step;
+    for (int j = 0; j < w.P; ++j) {
+      int k = 0;
+      for (int y = -1; y < 11; ++y) {
+        for (int x = -1; x < 11; ++x) {
+          ASSERT_EQ(seen(w.map.lookup(x, y, w.leaves[j], w.tree)), before[j][k++]) << "step " << step;
+        }
+      }
+    }
+  }
+}
+
+TEST(DpSlamMap, CollapseMovesEntriesUpAndKeepsTheNewerDuplicate) {
+  AncestryTree tree;
+  DpSlamMap map(0.1, 4.0);
+  const int root = tree.createRoot();
+  map.observe(0, 0, root, tree, 0.1, true);
+  map.observe(1, 0, root, tree, 0.1, false);
+  const auto kids = tree.advance({root}, {0, 0}, 1, map);
+  map.observe(0, 0, kids[0], tree, 0.1, false);  // duplicate of the root's cell (0, 0)
+  map.observe(2, 0, kids[0], tree, 0.1, true);   // a cell only the child saw
+  map.observe(1, 0, kids[1], tree, 0.1, true);
+  EXPECT_EQ(map.entryCount(), 5u);
+  // Particle 0 survives alone: kids[1] is pruned, kids[0] collapses into the root.
+  const auto next = tree.advance(kids, {0}, 2, map);
+  ASSERT_EQ(next, std::vector<int>{root});
+  EXPECT_EQ(tree.size(), 1u);
+  int n = 0;
+  const MapEntry* e = map.cellEntries(0, 0, &n);
+  ASSERT_EQ(n, 1);
+  EXPECT_EQ(e->owner, root);
+  EXPECT_FLOAT_EQ(e->distance, 0.6f);  // the child's (larger distance) won
+  e = map.cellEntries(1, 0, &n);
+  ASSERT_EQ(n, 1);
+  EXPECT_FLOAT_EQ(e->hits, 0.0f);  // the pruned sibling's hit is gone
+  e = map.cellEntries(2, 0, &n);
+  ASSERT_EQ(n, 1);
+  EXPECT_EQ(e->owner, root);
+  EXPECT_EQ(map.entryCount(), 3u);
+  EXPECT_EQ(map.nodeEntryCount(root), 3u);
+  EXPECT_EQ(map.check(), "");
+}
+
+TEST(DpSlamMap, PruningFreesCellsAndStorageIsReused) {
+  AncestryTree tree;
+  DpSlamMap map(0.1, 4.0);
+  const int root = tree.createRoot();
+  for (int x = 0; x < 10; ++x) map.observe(x, 0, root, tree, 0.1, false);
+  auto kids = tree.advance({root}, {0, 0}, 1, map);
+  for (int x = 0; x < 10; ++x) map.observe(x, 5, kids[1], tree, 0.1, true);  // only particle 1 saw row 5
+  EXPECT_EQ(map.observedCells(), 20u);
+  kids = tree.advance(kids, {0, 0}, 2, map);  // particle 1 dies
+  for (int x = 0; x < 10; ++x) {
+    int n = -1;
+    EXPECT_EQ(map.cellEntries(x, 5, &n), nullptr);
+    EXPECT_EQ(n, 0);
+  }
+  EXPECT_EQ(map.observedCells(), 10u);
+  EXPECT_EQ(map.entryCount(), 10u);
+  EXPECT_EQ(map.check(), "");
+  // Many write/kill cycles over the same area: the memory stays bounded (freed blocks are reused).
+  World w(16, 11);
+  std::size_t after_warmup = 0;
+  for (int step = 2; step < 400; ++step) {
+    w.writeRandom(40);
+    w.leaves = w.tree.advance(w.leaves, w.randomParents(), step, w.map);
+    if (step == 50) after_warmup = w.map.memoryBytes();
+  }
+  EXPECT_LE(w.map.memoryBytes(), after_warmup * 2);
+  EXPECT_LE(w.map.entryCount(), 144u * (2 * 16 - 1));
+  EXPECT_EQ(w.map.check(), "");
+}
+
+TEST(DpSlamMap, GrowsInEveryDirection) {
+  AncestryTree tree;
+  DpSlamMap map(0.05, 4.0);
+  const int root = tree.createRoot();
+  const int pts[][2] = {{0, 0}, {-5000, 3}, {7000, -9000}, {-123, 45678}, {64, 64}, {-1, -1}};
+  for (const auto& p : pts) map.observe(p[0], p[1], root, tree, 0.01, true);
+  for (const auto& p : pts) {
+    int n = 0;
+    map.cellEntries(p[0], p[1], &n);
+    EXPECT_EQ(n, 1) << p[0] << " " << p[1];
+  }
+  int x0, y0, x1, y1;
+  ASSERT_TRUE(map.bounds(&x0, &y0, &x1, &y1));
+  EXPECT_LE(x0, -5000);
+  EXPECT_GE(x1, 7000);
+  EXPECT_LE(y0, -9000);
+  EXPECT_GE(y1, 45678);
+  EXPECT_EQ(map.observedCells(), 6u);
+}
+
+TEST(DpSlamMap, AddBeamWritesChordsAndTheHit) {
+  AncestryTree tree;
+  DpSlamMap map(0.1, 4.0);
+  const int root = tree.createRoot();
+  LookupCache cache;
+  cache.begin(tree, {root});
+  MapBeam b;
+  b.ox = 0.05;
+  b.oy = 0.05;
+  b.range = 0.72;  // ends at x = 0.77, in cell 7, 0.07 m into it
+  map.addBeam(b, 20.0, 0, root, cache);
+  map.addBeam(b, 20.0, 0, root, cache);  // twice: in place
+  int n = 0;
+  const MapEntry* e = map.cellEntries(0, 0, &n);
+  ASSERT_EQ(n, 1);
+  EXPECT_NEAR(e->distance, 2 * 0.05 + 0.4, 1e-6);
+  e = map.cellEntries(3, 0, &n);
+  EXPECT_NEAR(e->distance, 2 * 0.1 + 0.4, 1e-6);
+  EXPECT_EQ(e->hits, 0.0f);
+  e = map.cellEntries(7, 0, &n);
+  EXPECT_NEAR(e->distance, 2 * 0.07 + 0.4, 1e-6);
+  EXPECT_EQ(e->hits, 2.0f);
+  EXPECT_EQ(map.cellEntries(8, 0, &n), nullptr);
+  // A return beyond the tracing cap only writes free space up to the cap.
+  b.oy = 1.05;
+  b.range = 30.0;
+  map.addBeam(b, 0.5, 0, root, cache);  // up to x = 0.55
+  e = map.cellEntries(5, 10, &n);
+  ASSERT_EQ(n, 1);
+  EXPECT_EQ(e->hits, 0.0f);
+  EXPECT_NEAR(e->distance, 0.05 + 0.4, 1e-6);
+  EXPECT_EQ(map.cellEntries(6, 10, &n), nullptr);
+  EXPECT_EQ(map.check(), "");
+}
+
+// Hand-computed beams through a known map (resolution 0.1 m, σ = 0.13 m, window 0.5 m, floor −1.15).
+TEST(DpSlamMap, ObservationModelValues) {
+  AncestryTree tree;
+  DpSlamMap map(0.1, 4.0);
+  const int root = tree.createRoot();
+  // Cells x = 0..9 of row 0: free (no hits). Cell x = 10: a wall, density 20 /m: stop probability
+  // across it 1 − e^−2. Cell x = 11: an opaque wall (density 2e4 /m). Beyond: unknown.
+  for (int x = 0; x < 10; ++x) map.observe(x, 0, root, tree, 1.0, false);
+  map.observe(10, 0, root, tree, 0.05 - 0.4, true);   // hits 1, distance 0.05 (prior 0.4 included)
+  map.observe(11, 0, root, tree, 5e-5 - 0.4, true);   // hits 1, distance 5e-5
+  BeamModelConfig m;
+  LookupCache cache;
+  cache.begin(tree, {root});
+  const double s2 = 2 * m.sigma * m.sigma;
+  auto beam = [](double range, bool no_return = false) {
+    MapBeam b;
+    b.ox = 0.05;
+    b.oy = 0.05;
+    b.range = range;
+    b.no_return = no_return;
+    return b;
+  };
+  // Return at 1.00 m (the middle of cell 10): stops in cell 10 with p1 = 1 − e^−2 (error 0), else in
+  // cell 11 (error 0.1 m); normalised by the total stop probability (≈ 1).
+  {
+    const double p1 = 1 - std::exp(-2.0), p2 = std::exp(-2.0) * (1 - std::exp(-2e4 * 0.1));
+    const double expected = std::log((p1 + p2 * std::exp(-0.01 / s2)) / (p1 + p2));
+    EXPECT_NEAR(map.beamLogLikelihood(beam(1.0), 20.0, 0, cache, m), expected, 1e-6);  // float statistics
+    EXPECT_NEAR(expected, -0.0353, 1e-4);
+  }
+  // Return at 0.90 m: errors 0.1 and 0.2 m.
+  {
+    const double p1 = 1 - std::exp(-2.0), p2 = std::exp(-2.0);
+    const double expected = std::log((p1 * std::exp(-0.01 / s2) + p2 * std::exp(-0.04 / s2)) / (p1 + p2));
+    EXPECT_NEAR(map.beamLogLikelihood(beam(0.9), 20.0, 0, cache, m), expected, 1e-6);
+  }
+  // Return at 0.45 m, in free space: the walls are 0.55 m and more away (outside the window) → floor.
+  EXPECT_DOUBLE_EQ(map.beamLogLikelihood(beam(0.45), 20.0, 0, cache, m), m.log_floor);
+  // Return at 0.70 m: error ≥ 0.3 m, likelihood e^(−0.09/2σ²) ≈ e^−2.7, floored.
+  EXPECT_DOUBLE_EQ(map.beamLogLikelihood(beam(0.7), 20.0, 0, cache, m), m.log_floor);
+  // No return up to 0.9 m (all free): certain.
+  EXPECT_NEAR(map.beamLogLikelihood(beam(0.9, true), 20.0, 0, cache, m), 0.0, 1e-12);
+  // No return up to 0.99 m: passes through the first half of cell 10 (0.04 m at 20 /m) with p = e^−0.8;
+  // a stop there (error ≈ 0.01 m from the end) also explains "nothing before 0.99 m" in DP-SLAM's model.
+  {
+    const double pass = std::exp(-0.8);
+    const double expected = std::log((1 - pass) * std::exp(-std::pow(0.97 - 0.99, 2) / s2) + pass);
+    EXPECT_NEAR(map.beamLogLikelihood(beam(0.99, true), 20.0, 0, cache, m), expected, 1e-6);
+  }
+  // No return through the opaque wall: floor.
+  EXPECT_DOUBLE_EQ(map.beamLogLikelihood(beam(3.0, true), 20.0, 0, cache, m), m.log_floor);
+  // A return beyond the cap is a no-return up to the cap.
+  EXPECT_NEAR(map.beamLogLikelihood(beam(30.0), 0.9, 0, cache, m), 0.0, 1e-12);
+  // Unknown space only (row 5): stops spread with density 1/8 per m; eval/(1 − reach) by summation.
+  {
+    MapBeam b = beam(2.0);
+    b.oy = 0.55;
+    double reach = 1.0, eval = 0.0;
+    for (int k = 0; k < 25; ++k) {  // cells [0, 0.05], then 0.1 m cells up to 2.5 m
+      const double t0 = k == 0 ? 0.0 : 0.05 + 0.1 * (k - 1), t1 = 0.05 + 0.1 * k;
+      const double stop = reach * (1 - std::exp(-(t1 - t0) / 8.0));
+      reach -= stop;
+      const double e = 0.5 * (t0 + t1) - 2.0;
+      if (std::abs(e) < 0.5) eval += stop * std::exp(-e * e / s2);
+    }
+    const double expected = std::max(std::log(eval / (1 - reach)), m.log_floor);
+    EXPECT_NEAR(map.beamLogLikelihood(b, 20.0, 0, cache, m), expected, 1e-9);
+    EXPECT_DOUBLE_EQ(expected, m.log_floor);  // unknown space explains a return poorly
+  }
+  // The cheap endpoint score agrees with the full one when the beam starts in free space.
+  EXPECT_NEAR(map.beamEndpointLogLikelihood(beam(1.0), 0.5, 0, cache, m),
+              map.beamLogLikelihood(beam(1.0), 20.0, 0, cache, m), 1e-9);
+}

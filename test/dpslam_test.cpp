@@ -1,0 +1,207 @@
+#include "laser_dpslam/dpslam.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "laser_dpslam/laser_odometry.h"
+#include "laser_dpslam/scan_simulator.h"
+#include "laser_dpslam/sim_path.h"
+#include "test_rooms.h"
+
+using namespace laser_dpslam;
+
+namespace {
+
+// Two laps of a loop around the furnished room (8 m × 6 m) at iRobot Create speeds, URG-04LX at 10 Hz,
+// every scan through the laser odometry: the SLAM's input, as in the real pipeline.
+struct SimRun {
+  std::vector<TimedPose> truth;
+  std::vector<PreprocessedScan> scans;
+  std::vector<OdometryUpdate> odometry;
+};
+
+const SimRun& loopRun() {
+  static const SimRun run = [] {
+    SimRun r;
+    const FloorPlan room = test::furnishedRoom();
+    const std::vector<Eigen::Vector2d> loop{{1.5, 2.5}, {3.2, 3.0}, {6.5, 2.0}, {7.0, 5.0}, {4.5, 5.0}, {1.5, 3.5}, {1.5, 2.5}};
+    r.truth = samplePath(repeatLoop(loop, 2), 10.0, PathConfig());
+    ScanSimulator sim(room, ScanSimulatorConfig(), 21);
+    LaserOdometry odom;
+    for (const auto& tp : r.truth) {
+      r.scans.push_back(preprocessScan(sim.simulate(tp.pose, 50.0 + tp.stamp), ScanPreprocessorConfig()));
+      r.odometry.push_back(odom.process(r.scans.back(), LaserMount()));
+    }
+    return r;
+  }();
+  return run;
+}
+
+std::vector<StampedPose> runSlam(const DpSlamConfig& config, std::size_t scans, DpSlam* keep = nullptr) {
+  const SimRun& run = loopRun();
+  DpSlam local(config);
+  DpSlam& slam = keep ? *keep : local;
+  for (std::size_t i = 0; i < scans; ++i) {
+    slam.process(run.scans[i].stamp, run.scans[i], LaserMount(), run.odometry[i].delta, run.odometry[i].delta_covariance);
+  }
+  return slam.bestTrajectory();
+}
+
+}  // namespace
+
+TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
+  const SimRun& run = loopRun();
+  DpSlamConfig config;
+  DpSlam slam(config);
+  const FloorPlan room = test::furnishedRoom();
+  const Pose2D start = run.truth.front().pose;  // the map frame is the first base frame
+  std::vector<double> ms;
+  std::size_t max_nodes = 0, max_entries = 0;
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const DpSlamUpdate u = slam.process(run.scans[i].stamp, run.scans[i], LaserMount(), run.odometry[i].delta,
+                                        run.odometry[i].delta_covariance);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    ASSERT_TRUE(u.ok) << "scan " << i << ": " << u.skip_reason;
+    ASSERT_LE(u.tree_nodes, static_cast<std::size_t>(2 * config.particles - 1));
+    ASSERT_TRUE(u.covariance.allFinite());
+    max_nodes = std::max(max_nodes, u.tree_nodes);
+    max_entries = std::max(max_entries, u.map_entries);
+  }
+  // Pose error at the end and along the whole (final best) trajectory.
+  const Pose2D end_truth = between(start, run.truth.back().pose);
+  const Pose2D end = slam.bestPose();
+  const double end_err = std::hypot(end.x - end_truth.x, end.y - end_truth.y);
+  const double end_rot = std::abs(normalizeAngle(end.theta - end_truth.theta));
+  const std::vector<StampedPose> traj = slam.bestTrajectory();
+  ASSERT_EQ(traj.size(), run.scans.size());
+  double max_err = 0.0;
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    const Pose2D t = between(start, run.truth[i].pose);
+    EXPECT_EQ(traj[i].stamp, run.scans[i].stamp);
+    max_err = std::max(max_err, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
+  }
+  EXPECT_LT(end_err, 0.05);
+  EXPECT_LT(end_rot, 1.5 * M_PI / 180.0);
+  EXPECT_LT(max_err, 0.12);
+  // The map's walls are the floor plan's: occupied cells lie on the plan's walls, and the walls the robot
+  // saw (the stub, the pillar, the cabinet, the outer walls) are in the map.
+  const OccupancyGridData map = slam.bestMap();
+  ASSERT_GT(map.width, 0);
+  int occupied = 0, on_wall = 0;
+  auto plan_point = [&](int ix, int iy) {
+    return start.transform(Eigen::Vector2d(map.origin_x + (ix + 0.5) * map.resolution, map.origin_y + (iy + 0.5) * map.resolution));
+  };
+  for (int iy = 0; iy < map.height; ++iy) {
+    for (int ix = 0; ix < map.width; ++ix) {
+      if (map.at(ix, iy) < 65) continue;
+      ++occupied;
+      if (room.clearance(plan_point(ix, iy), 0.2) <= 0.06) ++on_wall;
+    }
+  }
+  EXPECT_GT(occupied, 400);
+  EXPECT_GT(on_wall, 0.97 * occupied) << on_wall << " of " << occupied << " occupied cells on the plan's walls";
+  auto occupied_near = [&](double x, double y) {  // plan-frame point: an occupied map cell within 0.1 m?
+    const Eigen::Vector2d m = start.inverse().transform(Eigen::Vector2d(x, y));
+    const int cx = static_cast<int>(std::floor((m.x() - map.origin_x) / map.resolution));
+    const int cy = static_cast<int>(std::floor((m.y() - map.origin_y) / map.resolution));
+    for (int dy = -2; dy <= 2; ++dy) {
+      for (int dx = -2; dx <= 2; ++dx) {
+        const int ix = cx + dx, iy = cy + dy;
+        if (ix >= 0 && iy >= 0 && ix < map.width && iy < map.height && map.at(ix, iy) >= 65) return true;
+      }
+    }
+    return false;
+  };
+  for (double y = 0.6; y < 2.0; y += 0.2) EXPECT_TRUE(occupied_near(4.0, y)) << "stub, y " << y;       // wall stub face
+  for (double x = 5.85; x < 6.2; x += 0.1) EXPECT_TRUE(occupied_near(x, 3.8)) << "pillar, x " << x;   // pillar bottom
+  for (double x = 1.1; x < 2.4; x += 0.2) EXPECT_TRUE(occupied_near(x, 4.9)) << "cabinet, x " << x;   // cabinet front
+  for (double x = 2.0; x < 7.5; x += 0.5) EXPECT_TRUE(occupied_near(x, 0.1)) << "bottom wall, x " << x;
+  // Free space where the robot drove, unknown far outside.
+  const Eigen::Vector2d inside = start.inverse().transform(Eigen::Vector2d(3.0, 3.0));
+  EXPECT_EQ(map.at(static_cast<int>((inside.x() - map.origin_x) / map.resolution),
+                   static_cast<int>((inside.y() - map.origin_y) / map.resolution)), 0);
+  std::sort(ms.begin(), ms.end());
+  std::printf("[ DpSlam   ] %zu scans, %d particles: per-scan median %.2f ms, p95 %.2f ms, max %.2f ms; "
+              "tree <= %zu nodes, <= %zu map entries (%.1f MB); end error %.3f m %.2f deg, max %.3f m\n",
+              ms.size(), config.particles, ms[ms.size() / 2], ms[ms.size() * 95 / 100], ms.back(), max_nodes,
+              max_entries, slam.memoryBytes() / 1e6, end_err, end_rot * 180 / M_PI, max_err);
+}
+
+TEST(DpSlam, SameSeedGivesIdenticalTrajectoriesWithOneOrTwoThreads) {
+  DpSlamConfig one, two, other;
+  one.threads = 1;
+  two.threads = 2;
+  other.threads = 2;
+  other.seed = 2;
+  const std::size_t n = 250;
+  const std::vector<StampedPose> a = runSlam(one, n), b = runSlam(two, n), c = runSlam(other, n);
+  ASSERT_EQ(a.size(), n);
+  ASSERT_EQ(b.size(), n);
+  bool differs = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(a[i].stamp, b[i].stamp);
+    ASSERT_EQ(a[i].pose.x, b[i].pose.x) << i;  // bit for bit
+    ASSERT_EQ(a[i].pose.y, b[i].pose.y) << i;
+    ASSERT_EQ(a[i].pose.theta, b[i].pose.theta) << i;
+    differs = differs || a[i].pose.x != c[i].pose.x;
+  }
+  EXPECT_TRUE(differs) << "the seed has no effect";
+  // reset() starts over: the same run again gives the same result.
+  DpSlam slam(two);
+  runSlam(two, n, &slam);
+  slam.reset();
+  const std::vector<StampedPose> again = runSlam(two, n, &slam);
+  ASSERT_EQ(again.size(), n);
+  EXPECT_EQ(again.back().pose.x, b.back().pose.x);
+}
+
+TEST(DpSlam, UnusableScansMoveTheParticlesAndAreReported) {
+  const SimRun& run = loopRun();
+  DpSlam slam{DpSlamConfig()};
+  PreprocessedScan empty;
+  empty.error = "malformed";
+  // Before the first usable scan nothing happens.
+  DpSlamUpdate u = slam.process(1.0, empty, LaserMount(), Pose2D(), Eigen::Matrix3d::Identity());
+  EXPECT_FALSE(u.ok);
+  EXPECT_EQ(u.skip_reason, "malformed_scan");
+  EXPECT_FALSE(slam.initialized());
+  EXPECT_TRUE(slam.bestTrajectory().empty());
+  for (std::size_t i = 0; i < 120; ++i) {
+    PreprocessedScan s = run.scans[i];
+    if (i % 10 == 5) {
+      s.points.resize(3);
+      s.ranges.resize(3);
+      s.angles.resize(3);
+      s.beams.resize(3);
+    }
+    u = slam.process(s.stamp, s, LaserMount(), run.odometry[i].delta, run.odometry[i].delta_covariance);
+    if (i % 10 == 5) {
+      EXPECT_FALSE(u.ok);
+      EXPECT_EQ(u.skip_reason, "too_few_points");
+      EXPECT_FALSE(u.map_updated);
+    } else {
+      EXPECT_TRUE(u.ok) << i;
+    }
+  }
+  // Every call left a pose, and the skipped ones did not derail the estimate.
+  EXPECT_EQ(slam.bestTrajectory().size(), 120u);
+  const Pose2D t = between(run.truth.front().pose, run.truth[119].pose);
+  EXPECT_LT(std::hypot(slam.bestPose().x - t.x, slam.bestPose().y - t.y), 0.05);
+  EXPECT_EQ(slam.particlePoses().size(), static_cast<std::size_t>(DpSlamConfig().particles));
+}
+
+TEST(DpSlam, InvalidConfigurationsAreRejected) {
+  DpSlamConfig c;
+  c.particles = 0;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c = DpSlamConfig();
+  c.beam.log_floor = 0.1;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c = DpSlamConfig();
+  c.threads = 0;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+}
