@@ -12,8 +12,8 @@ For every dataset and setting: writes DIR/NAME/SETTING/config.yaml (only the stu
 keeps config/laser_odometry.yaml's defaults), runs `dpslam_offline --bag BAG --out ... --odometry-only
 --config config.yaml --quiet`, then tools/evaluate_trajectory against TRUTH (SE(2)-aligned ATE, drift in %
 of the distance, RPE per metre), once per DE seed 1..N (--seeds, default 3: single runs of this odometry
-differ a lot from seed to seed, so the table shows medians over the seeds and the worst drift). Settings (default: one factor at a time around the defaults
-NP 20, G 30, cells [1.0, 0.5], saliency, plus the full NP x G grid):
+differ a lot from seed to seed, so the table shows medians over the seeds and the worst drift). Settings
+(default: one factor at a time around the defaults NP 20, G 30, cells [1.0, 0.5], saliency, plus the full NP x G grid):
   NP in {10, 20, 40} x G in {10, 20, 30, 50}         (cells [1.0, 0.5], saliency)
   cells in {[0.5], [1.0], [2.0, 1.0, 0.5]}           (NP 20, G 30, saliency)
   resampling uniform                                  (NP 20, G 30, cells [1.0, 0.5])
@@ -172,9 +172,9 @@ def write_table(path, rows, datasets, full, jobs, seeds, elapsed):
                     cols[0] += ' (%d of %d runs failed)' % (r['runs'] - r['ok_runs'], r['runs'])
             else:
                 cols = ['failed: %s' % r['errors'][0]] + [''] * 7
-            lines.append('| %s%d%s | %s%d%s | %s | %s | %s |' % (
-                b, r['de_population'], b, b, r['de_generations'], b, cells_str(r['ndt_cell_sizes']), r['resampling'],
-                ' | '.join(cols)))
+            lines.append('| %s%d%s | %s%d%s | %s%s%s | %s%s%s | %s |' % (
+                b, r['de_population'], b, b, r['de_generations'], b, b, cells_str(r['ndt_cell_sizes']), b,
+                b, r['resampling'], b, ' | '.join(cols)))
         lines.append('')
     with open(path, 'w') as f:
         f.write('\n'.join(lines))

@@ -7,7 +7,8 @@
 #
 # Default datasets: the loop of plans/loop_building simulated once with simulate_scans (seed 1; kept in
 # out/parameter_study/sim_loop_building/ and re-simulated only when the plan or simulate_scans changed) and
-# the bundled bags/demo.bag (plans/office). --bag/--truth replace them with one bag of your own.
+# the bundled bags/demo.bag (plans/office). --bag/--truth replace them with one bag of your own (outputs
+# then in out/parameter_study_NAME/).
 # For every setting: dpslam_offline --odometry-only --config <generated yaml>, then tools/evaluate_trajectory
 # against the ground truth, for DE seeds 1..N (default 3; 2 runs at a time); see scripts/parameter_study.py
 # for the settings. Writes out/parameter_study/table.md (medians over the seeds of ATE, drift, RPE, bad-match
@@ -27,7 +28,7 @@ while (($#)); do
     --jobs) PASS+=(--jobs "$2"); shift 2 ;;
     --seeds) PASS+=(--seeds "$2"); shift 2 ;;
     --no-build) BUILD=0; shift ;;
-    -h|--help) sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,17p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "parameter_study.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -53,6 +54,7 @@ else
 fi
 
 OUT="$REPO/out/parameter_study"
+if [[ -n "$BAG" ]]; then OUT="$REPO/out/parameter_study_$NAME"; fi
 mkdir -p "$OUT"
 DATASETS=()
 if [[ -n "$BAG" ]]; then
@@ -60,10 +62,15 @@ if [[ -n "$BAG" ]]; then
 else
   SIM="$OUT/sim_loop_building"
   SIMULATOR="$(catkin_find --first-only laser_dpslam simulate_scans 2>/dev/null || true)"
-  if [[ ! -f "$SIM/sim.bag" || ! -f "$SIM/ground_truth.tum" || "$REPO/plans/loop_building.pgm" -nt "$SIM/sim.bag" \
-        || "$REPO/plans/loop_building_loop.txt" -nt "$SIM/sim.bag" || ( -n "$SIMULATOR" && "$SIMULATOR" -nt "$SIM/sim.bag" ) ]]; then
+  stale=0
+  for f in "$REPO/plans/loop_building.yaml" "$REPO/plans/loop_building.pgm" "$REPO/plans/loop_building_loop.txt" \
+           "$SIMULATOR"; do
+    if [[ -n "$f" && "$f" -nt "$SIM/sim.bag" ]]; then stale=1; fi
+  done
+  if [[ ! -f "$SIM/sim.bag" || ! -f "$SIM/ground_truth.tum" ]] || ((stale)); then
     echo "[parameter_study] simulating the loop of plans/loop_building (seed 1) -> $SIM" >&2
-    rosrun laser_dpslam simulate_scans --floorplan "$REPO/plans/loop_building.yaml" --path loop --out "$SIM" --seed 1 >&2
+    rosrun laser_dpslam simulate_scans --floorplan "$REPO/plans/loop_building.yaml" --path loop --out "$SIM" \
+      --seed 1 >&2
   fi
   DATASETS+=(--dataset loop_building "$SIM/sim.bag" "$SIM/ground_truth.tum")
   DATASETS+=(--dataset demo_office "$REPO/bags/demo.bag" "$REPO/bags/demo_ground_truth.tum")
