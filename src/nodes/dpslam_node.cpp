@@ -29,6 +29,7 @@
 #include "laser_dpslam/ros/msg_conversion.h"
 #include "laser_dpslam/ros/names.h"
 #include "laser_dpslam/ros/ros_parameter_source.h"
+#include "laser_dpslam/ros/tf_wait.h"
 #include "laser_dpslam/scan_preprocessor.h"
 
 namespace laser_dpslam {
@@ -73,7 +74,7 @@ class DpSlamNode {
   bool lookup(const std::string& target, const std::string& source, const ros::Time& stamp,
               geometry_msgs::TransformStamped* out, const char* what) {
     try {
-      *out = tf_buffer_.lookupTransform(target, source, stamp, ros::Duration(transform_timeout_));
+      *out = lookupTransformWall(tf_buffer_, target, source, stamp, transform_timeout_);
       return true;
     } catch (const tf2::TransformException& e) {
       ROS_ERROR_THROTTLE(5.0, "dpslam_node: no transform %s -> %s at the scan's stamp (%s); scan dropped. tf2: %s",

@@ -14,6 +14,7 @@
 #include "laser_dpslam/ros/msg_conversion.h"
 #include "laser_dpslam/ros/names.h"
 #include "laser_dpslam/ros/ros_parameter_source.h"
+#include "laser_dpslam/ros/tf_wait.h"
 #include "laser_dpslam/run_statistics.h"
 #include "laser_dpslam/scan_preprocessor.h"
 
@@ -52,7 +53,7 @@ class LaserOdometryNode {
       mount_ = LaserMount();
     } else {
       try {
-        const auto t = tf_buffer_.lookupTransform(base_frame_, laser_frame, stamp, ros::Duration(transform_timeout_));
+        const auto t = lookupTransformWall(tf_buffer_, base_frame_, laser_frame, stamp, transform_timeout_);
         mount_ = mountFromTransform(t.transform);
       } catch (const tf2::TransformException& e) {
         // Static transforms are valid at any time: try the latest one before giving up.
