@@ -22,6 +22,8 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.keyframe_distance, d.keyframe_distance);
   EXPECT_EQ(o.keyframe_angle, d.keyframe_angle);
   EXPECT_EQ(o.local_map_keyframes, d.local_map_keyframes);
+  EXPECT_EQ(o.keyframe_overlap_drop, d.keyframe_overlap_drop);
+  EXPECT_EQ(o.prior_acceleration, d.prior_acceleration);
   EXPECT_EQ(o.map_voxel, d.map_voxel);
   EXPECT_EQ(o.min_points, d.min_points);
   EXPECT_EQ(o.max_prior_gap, d.max_prior_gap);
@@ -49,6 +51,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(m.degeneracy_ratio, dm.degeneracy_ratio);
   EXPECT_EQ(m.degenerate_sigma, dm.degenerate_sigma);
   EXPECT_EQ(m.keep_prior_when_degenerate, dm.keep_prior_when_degenerate);
+  EXPECT_EQ(m.prior_sigma_xy, dm.prior_sigma_xy);
   EXPECT_EQ(m.weak_score, dm.weak_score);
   EXPECT_EQ(m.weak_matched_fraction, dm.weak_matched_fraction);
   EXPECT_EQ(m.weak_inflation, dm.weak_inflation);

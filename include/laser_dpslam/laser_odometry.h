@@ -27,6 +27,14 @@ struct LaserOdometryConfig {
   double keyframe_distance = 0.25;   ///< m moved since the last keyframe before a new one is taken
   double keyframe_angle = 0.17;      ///< rad turned since the last keyframe before a new one is taken
   int local_map_keyframes = 5;       ///< keyframes in the local map
+  /// m/s²; > 0: the constant-velocity prior enters the Newton polish as a Gaussian on the translation with
+  /// σ = ½·a·dt² (the displacement an unmodelled acceleration a causes over the scan interval dt), see
+  /// ScanMatcherConfig::prior_sigma_xy. 0 = off.
+  double prior_acceleration = 2.0;
+  /// A new keyframe is also taken when the matched fraction fell this much below the first match after the
+  /// last keyframe: new structure came into view that the local map lacks (0 = off). Without it a robot whose
+  /// estimate stalls in a corridor never takes the keyframe that would show it the wall ahead.
+  double keyframe_overlap_drop = 0.1;
   double map_voxel = 0.05;           ///< m, voxel size of the local map's points
   int min_points = 20;               ///< fewer valid points: the scan is skipped
   double max_prior_gap = 1.0;        ///< s; a longer gap between scans gives a zero-velocity prior
@@ -79,6 +87,7 @@ class LaserOdometry {
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  ///< base frame, per second
   std::deque<Keyframe> keyframes_;
+  double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;
 };
 

@@ -44,7 +44,11 @@ struct ScanMatcherConfig {
   double min_sigma_theta = 0.002;       ///< rad, standard deviation floor
   double degeneracy_ratio = 0.02;       ///< eigenvalue of H's translation block below this × its largest: degenerate
   double degenerate_sigma = 0.3;        ///< m, σ added along a degenerate translation direction
-  bool keep_prior_when_degenerate = true;  ///< along a degenerate direction keep the motion prior (corridors)
+  bool keep_prior_when_degenerate = false;  ///< along a degenerate direction keep the motion prior exactly (superseded by the soft prior of LaserOdometryConfig::prior_acceleration)
+  /// m; > 0: the Newton polish minimises h + α/2·|t − t_prior|²/σ² (a Gaussian motion prior of this σ on the
+  /// translation, in h's units through Σ = α·H⁻¹): where the scan constrains the pose the data wins, along a
+  /// corridor the prior does, with no hard degeneracy threshold. 0 = off.
+  double prior_sigma_xy = 0.0;
   double weak_score = 0.25;             ///< score per point (0…1) below which the match is weak
   double weak_matched_fraction = 0.5;   ///< matched fraction below which the match is weak
   double weak_inflation = 10.0;         ///< covariance multiplier for a weak match
@@ -80,13 +84,15 @@ class ScanMatcher {
   /// DE searches with `search_points` (a resampled subset: the cost is evaluated hundreds of times);
   /// the Newton polish, the covariance and the quality use `polish_points` (more points: the precision
   /// of the estimate grows with them, and Newton needs only a few evaluations).
+  /// `prior_sigma_xy` < 0: the config's; otherwise this scan's σ of the motion prior (see the config).
   MatchResult match(const std::vector<Eigen::Vector2d>& search_points, const std::vector<Eigen::Vector2d>& polish_points,
-                    const Pose2D& prior, std::mt19937_64& rng) const;
+                    const Pose2D& prior, std::mt19937_64& rng, double prior_sigma_xy = -1.0) const;
 
   /// Newton polish only, from `start`, on resolution level `level` (exposed for tests). With `basis`
   /// (3×k, orthonormal columns) the steps stay in the subspace it spans.
   Pose2D polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
-                int* iterations = nullptr, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis = nullptr) const;
+                int* iterations = nullptr, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis = nullptr,
+                const Pose2D* prior = nullptr, double prior_sigma_xy = -1.0) const;
 
   const ScanMatcherConfig& config() const { return config_; }
   const NdtGrid& grid(std::size_t level) const { return grids_.at(level); }

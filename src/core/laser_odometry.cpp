@@ -26,6 +26,7 @@ void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points)
   for (const auto& p : base_points) kf.points.push_back(pose_.transform(p));
   kf.points = voxelFilter(kf.points, config_.map_voxel);
   keyframes_.push_back(std::move(kf));
+  keyframe_matched_ = -1.0;
   while (static_cast<int>(keyframes_.size()) > std::max(1, config_.local_map_keyframes)) keyframes_.pop_front();
   std::vector<Eigen::Vector2d> map;
   for (const auto& k : keyframes_) map.insert(map.end(), k.points.begin(), k.points.end());
@@ -106,7 +107,10 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
           : base_points;
   ++scan_count_;
   u.points_used = static_cast<int>(polish_points.size());
-  u.match = matcher_.match(match_points, polish_points, prior, rng_);
+  const double prior_sigma = config_.prior_acceleration > 0.0 && dt > 0.0 && dt <= config_.max_prior_gap
+                                 ? 0.5 * config_.prior_acceleration * dt * dt
+                                 : -1.0;
+  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma);
   if (!u.match.valid) {
     u.skip_reason = "match_failed";
     pose_ = prior;
@@ -134,8 +138,11 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
   last_stamp_ = scan.stamp;
 
   const Pose2D from_kf = between(keyframes_.back().pose, pose_);
+  if (keyframe_matched_ < 0.0) keyframe_matched_ = u.match.matched_fraction;
+  const bool overlap_dropped = config_.keyframe_overlap_drop > 0.0 &&
+                               u.match.matched_fraction < keyframe_matched_ - config_.keyframe_overlap_drop;
   if (std::hypot(from_kf.x, from_kf.y) > config_.keyframe_distance ||
-      std::abs(from_kf.theta) > config_.keyframe_angle) {
+      std::abs(from_kf.theta) > config_.keyframe_angle || overlap_dropped) {
     addKeyframe(base_points);
     u.new_keyframe = true;
   }

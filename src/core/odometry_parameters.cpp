@@ -39,6 +39,8 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   nonNegative(s, "keyframe_distance", o.keyframe_distance);
   nonNegative(s, "keyframe_angle", o.keyframe_angle);
   atLeast(s, "local_map_keyframes", o.local_map_keyframes, 1);
+  nonNegative(s, "keyframe_overlap_drop", o.keyframe_overlap_drop);
+  nonNegative(s, "prior_acceleration", o.prior_acceleration);
   nonNegative(s, "map_voxel", o.map_voxel);
   atLeast(s, "min_points", o.min_points, 3);
   positive(s, "max_prior_gap", o.max_prior_gap);
@@ -79,6 +81,7 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   positive(s, "degeneracy_ratio", m.degeneracy_ratio);
   positive(s, "degenerate_sigma", m.degenerate_sigma);
   s.get("keep_prior_when_degenerate", m.keep_prior_when_degenerate);
+  nonNegative(s, "prior_sigma_xy", m.prior_sigma_xy);
   nonNegative(s, "weak_score", m.weak_score);
   nonNegative(s, "weak_matched_fraction", m.weak_matched_fraction);
   positive(s, "weak_inflation", m.weak_inflation);

@@ -28,10 +28,24 @@ void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points) {
 bool ScanMatcher::hasReference() const { return !grids_.empty() && !grids_.back().empty(); }
 
 Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
-                           int* iterations, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis) const {
+                           int* iterations, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis,
+                           const Pose2D* prior, double prior_sigma_xy) const {
   const NdtGrid& grid = grids_.at(level);
+  // The motion prior as a quadratic term in h's units (Σ = α·H⁻¹ ⇒ information α⁻¹·H), see prior_sigma_xy.
+  const double sigma = prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy;
+  const double w = prior && sigma > 0.0 ? config_.covariance_scale / (sigma * sigma) : 0.0;
+  auto score = [&](const Pose2D& p) {
+    NdtScore r = grid.score(p, points, true);
+    if (w > 0.0) {
+      const Eigen::Vector2d d(p.x - prior->x, p.y - prior->y);
+      r.h += 0.5 * w * d.squaredNorm();
+      r.gradient.head<2>() += w * d;
+      r.hessian.topLeftCorner<2, 2>() += w * Eigen::Matrix2d::Identity();
+    }
+    return r;
+  };
   Pose2D pose = start;
-  NdtScore s = grid.score(pose, points, true);
+  NdtScore s = score(pose);
   int it = 0;
   for (; it < config_.newton_iterations; ++it) {
     // Newton with the Hessian made positive definite (algorithms.md §2).
@@ -55,7 +69,7 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
     for (int k = 0; k < 6; ++k) {
       const Pose2D cand(pose.x + step * delta.x(), pose.y + step * delta.y(),
                         normalizeAngle(pose.theta + step * delta.z()));
-      NdtScore cs = grid.score(cand, points, true);
+      NdtScore cs = score(cand);
       if (cs.h <= s.h) {
         pose = cand;
         s = cs;
@@ -103,7 +117,7 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, Matc
 
 MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
                                const std::vector<Eigen::Vector2d>& polish_points, const Pose2D& prior,
-                               std::mt19937_64& rng) const {
+                               std::mt19937_64& rng, double prior_sigma_xy) const {
   MatchResult r;
   r.pose = prior;
   if (!hasReference() || points.empty() || polish_points.empty()) return r;
@@ -134,7 +148,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   Pose2D pose = start;
   for (std::size_t level = 0; level < grids_.size(); ++level) {
     if (grids_[level].empty()) continue;
-    pose = polish(polish_points, pose, level, &r.newton_iterations);
+    pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, &prior, prior_sigma_xy);
   }
   NdtScore s = grids_.back().score(pose, polish_points, true);
   if (config_.keep_prior_when_degenerate) {

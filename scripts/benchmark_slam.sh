@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# scripts/benchmark_slam.sh: the full SLAM (laser odometry + DP-SLAM, `dpslam_offline`) on every dataset in
+# ../shared/datasets (when present) and on the bundled bags/demo.bag, for the default configuration and
+# other particle counts: error, real-time factor, CPU per scan, peak memory, ancestry-tree size.
+# Error: MIT CSAIL — the relations metric (all 1172 relations, and those <= 10 s apart); demo — ATE RMSE
+# against bags/demo_ground_truth.tum; the other logs have no ground truth (look at their map.png).
+# Usage: scripts/benchmark_slam.sh [--particles "30 10 60"] [DATASETS_DIR]
+set -euo pipefail
+PARTICLES="30 10 60"
+if [[ "${1:-}" == "--particles" ]]; then PARTICLES="$2"; shift 2; fi
+source "$(dirname "${BASH_SOURCE[0]}")/setup.sh" > /dev/null
+DATA="${1:-$REPO/../shared/datasets}"
+OUT="$REPO/out/benchmark_slam"
+mkdir -p "$OUT"
+
+convert() {  # format input output
+  [[ -f "$3" && "$3" -nt "$2" ]] || rosrun laser_dpslam log_to_bag --format "$1" "$2" "$3" > /dev/null
+}
+declare -A BAGS
+BAGS[demo]="$REPO/bags/demo.bag"
+if [[ -d "$DATA" ]]; then
+  if [[ -f "$DATA/mit-csail/mit-csail.clf" ]]; then convert carmen "$DATA/mit-csail/mit-csail.clf" "$OUT/mit-csail.bag"; BAGS[mit-csail]="$OUT/mit-csail.bag"; fi
+  for e in exp1 exp2; do
+    if [[ -f "$DATA/urg04lx-mines/$e.dat" ]]; then convert mines "$DATA/urg04lx-mines/$e.dat" "$OUT/mines-$e.bag"; BAGS[mines-$e]="$OUT/mines-$e.bag"; fi
+  done
+  if [[ -f "$DATA/dpslam-loop5/loop5.log" ]]; then convert dpslam "$DATA/dpslam-loop5/loop5.log" "$OUT/loop5.bag"; BAGS[loop5]="$OUT/loop5.bag"; fi
+  if [[ -f "$DATA/scan_tools-demo/laser_scan_matcher_demo.bag" ]]; then BAGS[scan_tools-demo]="$DATA/scan_tools-demo/laser_scan_matcher_demo.bag"; fi
+else
+  echo "no datasets at $DATA: only the bundled demo" >&2
+fi
+
+printf "%-16s %5s %6s %8s %8s %6s %7s %6s  %s\n" dataset P scans "slam ms" "p95 ms" "RT x" "RSS MB" "tree" "error"
+for name in $(printf "%s\n" "${!BAGS[@]}" | sort); do
+  for p in $PARTICLES; do
+    dir="$OUT/$name-p$p"
+    mkdir -p "$dir"
+    printf "particles: %s\n" "$p" > "$dir/config.yaml"
+    if ! rosrun laser_dpslam dpslam_offline --bag "${BAGS[$name]}" --out "$dir" --config "$dir/config.yaml" \
+         --quiet 2> "$dir/stderr.txt" > /dev/null; then
+      echo "$name P=$p: dpslam_offline failed, see $dir/stderr.txt"
+      continue
+    fi
+    err="(no ground truth: see $dir/map.png)"
+    if [[ $name == mit-csail ]]; then
+      rosrun laser_dpslam evaluate_relations --trajectory "$dir/trajectory.tum" --relations "$DATA/mit-csail/mit-csail.relations" > "$dir/relations_all.json"
+      rosrun laser_dpslam evaluate_relations --trajectory "$dir/trajectory.tum" --relations "$DATA/mit-csail/mit-csail.relations" --max-dt 10 > "$dir/relations_10s.json"
+      err=$(/usr/bin/python3 -c 'import json,sys; a=json.load(open(sys.argv[1])); b=json.load(open(sys.argv[2])); print("relations all %.4f m / %.3f deg (%d); <= 10 s %.4f m / %.3f deg" % (a["trans_abs_mean"], a["rot_abs_mean_deg"], a["used"], b["trans_abs_mean"], b["rot_abs_mean_deg"]))' "$dir/relations_all.json" "$dir/relations_10s.json")
+    elif [[ $name == demo ]]; then
+      rosrun laser_dpslam evaluate_trajectory --estimate "$dir/trajectory.tum" --reference "$REPO/bags/demo_ground_truth.tum" > "$dir/ate.json"
+      err=$(/usr/bin/python3 -c 'import json,sys; a=json.load(open(sys.argv[1])); print("ATE RMSE %.4f m (max %.3f m) over %.1f m" % (a["ate_rmse_m"], a["ate_max_m"], a["distance_m"]))' "$dir/ate.json")
+    fi
+    /usr/bin/python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); print("%-16s %5d %6d %8.2f %8.2f %6.1f %7.0f %6d  %s" % (sys.argv[2], s["particles"], s["scans"], s["slam_ms"]["median"], s["slam_ms"]["p95"], s["realtime_factor"], s["peak_rss_mb"], s.get("tree_nodes", -1), sys.argv[3]))' \
+      "$dir/stats.json" "$name" "$err"
+  done
+done
+echo "(slam ms: CPU per scan of the SLAM step; RT x: data time / wall time of the whole run, both threads; outputs in $OUT)"
