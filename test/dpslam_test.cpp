@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <string>
 
 #include "laser_dpslam/laser_odometry.h"
 #include "laser_dpslam/scan_simulator.h"
@@ -131,32 +133,93 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
               max_entries, slam.memoryBytes() / 1e6, end_err, end_rot * 180 / M_PI, max_err);
 }
 
-TEST(DpSlam, SameSeedGivesIdenticalTrajectoriesWithOneOrTwoThreads) {
+namespace {
+
+// Everything a run leaves: the best path and map, and every particle's pose and weight.
+struct SlamResult {
+  std::vector<StampedPose> trajectory;
+  OccupancyGridData map;
+  std::vector<Pose2D> particles;
+  std::vector<double> log_weights;
+};
+
+SlamResult runFull(const DpSlamConfig& config, std::size_t scans) {
+  DpSlam slam(config);
+  SlamResult r;
+  r.trajectory = runSlam(config, scans, &slam);
+  r.map = slam.bestMap();
+  r.particles = slam.particlePoses();
+  r.log_weights = slam.logWeights();
+  return r;
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+
+/// Bit for bit: == would call 0.0 and -0.0 equal and NaN unequal to itself.
+void expectIdentical(const SlamResult& a, const SlamResult& b, const std::string& what) {
+  ASSERT_EQ(a.trajectory.size(), b.trajectory.size()) << what;
+  for (std::size_t i = 0; i < a.trajectory.size(); ++i) {
+    const Pose2D &p = a.trajectory[i].pose, &q = b.trajectory[i].pose;
+    ASSERT_TRUE(sameBits(a.trajectory[i].stamp, b.trajectory[i].stamp) && sameBits(p.x, q.x) && sameBits(p.y, q.y) &&
+                sameBits(p.theta, q.theta))
+        << what << ": pose " << i;
+  }
+  EXPECT_EQ(a.map.width, b.map.width) << what;
+  EXPECT_EQ(a.map.height, b.map.height) << what;
+  EXPECT_TRUE(sameBits(a.map.origin_x, b.map.origin_x) && sameBits(a.map.origin_y, b.map.origin_y)) << what;
+  EXPECT_TRUE(a.map.data == b.map.data) << what << ": map cells differ";
+  ASSERT_EQ(a.particles.size(), b.particles.size()) << what;
+  ASSERT_EQ(a.log_weights.size(), b.log_weights.size()) << what;
+  for (std::size_t i = 0; i < a.particles.size(); ++i) {
+    EXPECT_TRUE(sameBits(a.particles[i].x, b.particles[i].x) && sameBits(a.particles[i].y, b.particles[i].y) &&
+                sameBits(a.particles[i].theta, b.particles[i].theta) && sameBits(a.log_weights[i], b.log_weights[i]))
+        << what << ": particle " << i;
+  }
+}
+
+}  // namespace
+
+TEST(DpSlam, SameSeedGivesIdenticalTrajectoriesAndMapsWithOneOrTwoThreads) {
   DpSlamConfig one, two, other;
   one.threads = 1;
   two.threads = 2;
   other.threads = 2;
   other.seed = 2;
-  const std::size_t n = 250;
-  const std::vector<StampedPose> a = runSlam(one, n), b = runSlam(two, n), c = runSlam(other, n);
-  ASSERT_EQ(a.size(), n);
-  ASSERT_EQ(b.size(), n);
+  const std::size_t n = 150;  // 15 s of data: resampling and tree pruning happen many times
+  const SlamResult a = runFull(one, n), b = runFull(two, n), b_again = runFull(two, n), c = runFull(other, 50);
+  ASSERT_EQ(a.trajectory.size(), n);
+  ASSERT_GT(a.map.width, 0);
+  expectIdentical(a, b, "1 vs 2 threads");
+  expectIdentical(b, b_again, "2 threads, twice");
+  // The comparisons can fail: another seed gives another result.
   bool differs = false;
-  for (std::size_t i = 0; i < n; ++i) {
-    ASSERT_EQ(a[i].stamp, b[i].stamp);
-    ASSERT_EQ(a[i].pose.x, b[i].pose.x) << i;  // bit for bit
-    ASSERT_EQ(a[i].pose.y, b[i].pose.y) << i;
-    ASSERT_EQ(a[i].pose.theta, b[i].pose.theta) << i;
-    differs = differs || a[i].pose.x != c[i].pose.x;
+  for (std::size_t i = 0; i < c.trajectory.size(); ++i) {
+    differs = differs || !sameBits(a.trajectory[i].pose.x, c.trajectory[i].pose.x);
   }
   EXPECT_TRUE(differs) << "the seed has no effect";
   // reset() starts over: the same run again gives the same result.
   DpSlam slam(two);
   runSlam(two, n, &slam);
   slam.reset();
-  const std::vector<StampedPose> again = runSlam(two, n, &slam);
-  ASSERT_EQ(again.size(), n);
-  EXPECT_EQ(again.back().pose.x, b.back().pose.x);
+  SlamResult again;
+  again.trajectory = runSlam(two, n, &slam);
+  again.map = slam.bestMap();
+  again.particles = slam.particlePoses();
+  again.log_weights = slam.logWeights();
+  expectIdentical(b, again, "after reset()");
+}
+
+TEST(DpSlam, OversamplingAndRefinementAreDeterministicAcrossThreadCounts) {
+  // The other parallel paths: cheap scores of K candidates per particle, and the hill-climbing proposal.
+  DpSlamConfig one;
+  one.particles = 12;
+  one.oversampling = 3;
+  one.refine_iterations = 4;
+  one.threads = 1;
+  DpSlamConfig two = one;
+  two.threads = 2;
+  const std::size_t n = 120;
+  expectIdentical(runFull(one, n), runFull(two, n), "oversampling + refinement, 1 vs 2 threads");
 }
 
 TEST(DpSlam, UnusableScansMoveTheParticlesAndAreReported) {

@@ -1,10 +1,15 @@
-// Fuzz: 10^5 randomly malformed scans through preprocessing → laser odometry (issue 6). Nothing may
-// crash or throw, and no pose, covariance or velocity may ever be non-finite.
+// Fuzz (issue 6): 10^5 randomly malformed scans through preprocessing → laser odometry, and a shorter
+// stream through preprocessing → odometry → DP-SLAM. Nothing may crash or throw, and no pose,
+// covariance, velocity, particle weight or map value may ever be non-finite or out of range.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <random>
 
+#include "laser_dpslam/dpslam.h"
 #include "laser_dpslam/laser_odometry.h"
 #include "laser_dpslam/scan_preprocessor.h"
 
@@ -92,4 +97,84 @@ TEST(Fuzz, MalformedScansNeverCrashOrPoisonTheOdometry) {
   EXPECT_GT(matched, 1000);
   RecordProperty("rejected", rejected);
   RecordProperty("matched", matched);
+}
+
+namespace {
+
+/// The exported map: consistent size, finite origin, every value -1 (unknown) or 0..100.
+::testing::AssertionResult mapIsSane(const OccupancyGridData& g) {
+  if (g.width < 0 || g.height < 0 || g.data.size() != static_cast<std::size_t>(g.width) * g.height)
+    return ::testing::AssertionFailure() << "map size " << g.width << "x" << g.height << " with " << g.data.size() << " cells";
+  if (!std::isfinite(g.origin_x) || !std::isfinite(g.origin_y) || !(g.resolution > 0.0))
+    return ::testing::AssertionFailure() << "map origin or resolution not finite";
+  for (std::int8_t v : g.data) {
+    if (v < -1 || v > 100) return ::testing::AssertionFailure() << "map value " << int(v);
+  }
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace
+
+TEST(Fuzz, MalformedScansThroughOdometryAndSlamNeverPoisonTheSlam) {
+  // Glue as in the nodes: every scan goes to the SLAM (malformed ones too: it must skip them), the motion
+  // is the odometry's delta and covariance, and time going backwards resets both.
+  std::mt19937_64 rng(20261123);
+  LaserOdometryConfig odom_config;
+  odom_config.matcher.de_generations = 5;
+  LaserOdometry odometry(odom_config);
+  DpSlamConfig slam_config;
+  slam_config.particles = 8;  // small: what is fuzzed is the input, and 10^4 scans must stay quick
+  slam_config.threads = 2;
+  slam_config.seed = 7;
+  DpSlam slam(slam_config);
+  const LaserMount mount = LaserMount::fromPose(Pose2D(0.1, 0.0, 0.0));
+  double stamp = 1000.0, previous = -1.0;
+  Pose2D last_odom;
+  bool has_last = false;
+  int slam_used = 0, slam_skipped = 0, resets = 0;
+  const int n = 10000;
+  for (int i = 0; i < n; ++i) {
+    const auto r = rng() % 50;
+    stamp += r == 0 ? -30.0 : r == 1 ? 0.0 : r == 2 ? 500.0 : 0.1;
+    const PreprocessedScan pre = preprocessScan(randomScan(rng, stamp), ScanPreprocessorConfig());
+    if (previous >= 0.0 && stamp < previous) {
+      slam.reset();
+      has_last = false;
+      ++resets;
+    }
+    previous = stamp;
+    OdometryUpdate u;
+    ASSERT_NO_THROW(u = odometry.process(pre, mount)) << "scan " << i;
+    if (u.skip_reason == "duplicate_stamp") continue;  // nothing new for this time
+    const Pose2D delta = has_last && !u.reset ? between(last_odom, u.pose) : Pose2D();
+    last_odom = u.pose;
+    has_last = true;
+    DpSlamUpdate s;
+    ASSERT_NO_THROW(s = slam.process(stamp, pre, mount, delta, u.delta_covariance)) << "scan " << i;
+    ASSERT_TRUE(s.pose.vector().allFinite()) << "scan " << i;
+    ASSERT_TRUE(s.covariance.allFinite()) << "scan " << i;
+    ASSERT_TRUE(std::isfinite(s.neff)) << "scan " << i;
+    ASSERT_LE(s.tree_nodes, static_cast<std::size_t>(2 * slam_config.particles - 1)) << "scan " << i;
+    for (const Pose2D& p : slam.particlePoses()) {
+      ASSERT_TRUE(p.vector().allFinite()) << "scan " << i;
+    }
+    for (double w : slam.logWeights()) {
+      ASSERT_TRUE(std::isfinite(w)) << "scan " << i;
+    }
+    (s.ok ? slam_used : slam_skipped)++;
+    if (i % 500 == 499) {
+      ASSERT_TRUE(mapIsSane(slam.bestMap())) << "scan " << i;
+    }
+  }
+  EXPECT_TRUE(mapIsSane(slam.bestMap()));
+  for (const StampedPose& p : slam.bestTrajectory()) {
+    ASSERT_TRUE(p.pose.vector().allFinite() && std::isfinite(p.stamp));
+  }
+  // Both the SLAM's skip paths and its filter must have been reached, and resets must have happened.
+  EXPECT_GT(slam_used, 1000);
+  EXPECT_GT(slam_skipped, 1000);
+  EXPECT_GT(resets, 50);
+  std::printf("[ Fuzz     ] SLAM: %d scans used, %d skipped, %d time resets\n", slam_used, slam_skipped, resets);
+  RecordProperty("slam_used", slam_used);
+  RecordProperty("slam_skipped", slam_skipped);
 }

@@ -2,8 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "laser_dpslam/floor_plan.h"
@@ -267,4 +274,115 @@ TEST(OccupancyExport, PngDecodesToTheMapAndTrajectory) {
   EXPECT_LT(png.size(), big.size() / 10);
   const DecodedPng db = decodePng(png);
   EXPECT_EQ(db.pixels, big);
+}
+
+// --- Failures to save (issue 6). The tests run as root, for whom chmod does not stop a write, so the
+// failures are forced with paths that cannot hold a file, and a full disk with /dev/full: the temporary
+// file the writer creates (PATH.tmp.<pid>) is made a symlink to it, so the writer's own write, flush and
+// fsync meet a real ENOSPC from the kernel.
+namespace {
+
+std::string freshDir(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + "/" + name + "_" + std::to_string(::getpid());
+  EXPECT_EQ(std::system(("rm -rf '" + dir + "'").c_str()), 0);
+  EXPECT_EQ(::mkdir(dir.c_str(), 0755), 0) << dir;
+  return dir;
+}
+
+std::vector<std::string> listDir(const std::string& dir) {
+  std::vector<std::string> names;
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n != "." && n != "..") names.push_back(n);
+    }
+    ::closedir(d);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+OccupancyGridData grid(int width, int height, std::int8_t value) {
+  OccupancyGridData g;
+  g.resolution = 0.05;
+  g.width = width;
+  g.height = height;
+  g.origin_x = -0.5 * width * g.resolution;
+  g.data.assign(static_cast<std::size_t>(width) * height, value);
+  return g;
+}
+
+/// Runs `write`, which must throw std::runtime_error; returns the message.
+std::string failureOf(const std::function<void()>& write) {
+  try {
+    write();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no exception";
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST(OccupancyExportFailure, UnwritableDestinationsThrowAnErrorNamingThePath) {
+  const std::string dir = freshDir("unwritable");
+  const OccupancyGridData g = grid(20, 10, 0);
+  // A directory that does not exist.
+  std::string e = failureOf([&] { writeMapServerFiles(g, dir + "/no_such_dir/map.yaml"); });
+  EXPECT_TRUE(contains(e, "'" + dir + "/no_such_dir/map.pgm'")) << e;
+  EXPECT_TRUE(contains(e, "No such file or directory")) << e;
+  e = failureOf([&] { writeMapPng(g, {}, dir + "/no_such_dir/map.png"); });
+  EXPECT_TRUE(contains(e, "'" + dir + "/no_such_dir/map.png'")) << e;
+  // A "directory" that is a regular file.
+  std::ofstream(dir + "/plain") << "not a directory";
+  e = failureOf([&] { writeMapServerFiles(g, dir + "/plain/map.yaml"); });
+  EXPECT_TRUE(contains(e, "'" + dir + "/plain/map.pgm'")) << e;
+  EXPECT_TRUE(contains(e, "Not a directory")) << e;
+  // /proc holds no regular files, not even for root.
+  e = failureOf([&] { writeMapServerFiles(g, "/proc/laser_dpslam_test_map.yaml"); });
+  EXPECT_TRUE(contains(e, "'/proc/laser_dpslam_test_map.pgm'")) << e;
+  EXPECT_NE(::access("/proc/laser_dpslam_test_map.pgm", F_OK), 0);
+  EXPECT_EQ(listDir(dir), std::vector<std::string>{"plain"});
+}
+
+TEST(OccupancyExportFailure, FullDiskKeepsThePreviousMapByteIdenticalAndLeavesNoTemporaries) {
+  if (::access("/dev/full", W_OK) != 0) GTEST_SKIP() << "no /dev/full";
+  const std::string dir = freshDir("full_disk");
+  const std::string yaml = dir + "/map.yaml", pgm = dir + "/map.pgm";
+  writeMapServerFiles(grid(20, 10, 0), yaml);
+  const std::string old_yaml = readFile(yaml), old_pgm = readFile(pgm);
+  ASSERT_FALSE(old_yaml.empty());
+  ASSERT_FALSE(old_pgm.empty());
+  const OccupancyGridData bigger = grid(300, 200, 100);  // another size and origin: a mixed pair would misplace it
+  // The disk fills up while the image is written, then (image done) while the YAML is written: either
+  // way the old pair survives, because nothing is renamed before both are complete.
+  for (const std::string& victim : {pgm, yaml}) {
+    const std::string tmp = victim + ".tmp." + std::to_string(::getpid());
+    ASSERT_EQ(::symlink("/dev/full", tmp.c_str()), 0) << tmp;
+    const std::string e = failureOf([&] { writeMapServerFiles(bigger, yaml); });
+    EXPECT_TRUE(contains(e, "'" + victim + "'")) << e;
+    EXPECT_TRUE(contains(e, "No space left on device")) << e;
+    EXPECT_EQ(readFile(pgm), old_pgm) << "victim " << victim;
+    EXPECT_EQ(readFile(yaml), old_yaml) << "victim " << victim;
+    EXPECT_EQ(listDir(dir), (std::vector<std::string>{"map.pgm", "map.yaml"})) << "victim " << victim;
+  }
+  // With space again the same write replaces both files (so the comparisons above could fail).
+  writeMapServerFiles(bigger, yaml);
+  EXPECT_NE(readFile(pgm), old_pgm);
+  EXPECT_NE(readFile(yaml), old_yaml);
+  EXPECT_EQ(listDir(dir), (std::vector<std::string>{"map.pgm", "map.yaml"}));
+}
+
+TEST(OccupancyExportFailure, AFailedRenameLeavesNoTemporaryAndTheYamlUntouched) {
+  const std::string dir = freshDir("rename");
+  const std::string yaml = dir + "/map.yaml";
+  std::ofstream(yaml) << "old yaml\n";
+  ASSERT_EQ(::mkdir((dir + "/map.pgm").c_str(), 0755), 0);  // the image's place is taken by a directory
+  const std::string e = failureOf([&] { writeMapServerFiles(grid(20, 10, 0), yaml); });
+  EXPECT_TRUE(contains(e, "'" + dir + "/map.pgm'")) << e;
+  EXPECT_EQ(readFile(yaml), "old yaml\n");
+  EXPECT_EQ(listDir(dir), (std::vector<std::string>{"map.pgm", "map.yaml"}));
 }

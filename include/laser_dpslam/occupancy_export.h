@@ -39,8 +39,8 @@ std::uint8_t pgmValue(std::int8_t occupancy);
 std::string formatPgm(const OccupancyGridData& grid);
 /// map_server YAML naming `image` (relative to the YAML's directory).
 std::string formatMapYaml(const OccupancyGridData& grid, const std::string& image);
-/// Writes YAML_PATH and the PGM beside it (same stem, .pgm), each through a temporary file and a rename.
-/// Throws std::runtime_error on I/O failure.
+/// Writes YAML_PATH and the PGM beside it (same stem, .pgm) with writeFilesAtomically: on a failure to
+/// write either, both previous files stay as they were. Throws std::runtime_error naming the path.
 void writeMapServerFiles(const OccupancyGridData& grid, const std::string& yaml_path);
 
 /// PNG bytes of an 8-bit palette image (rows top to bottom, `indices` row-major), zlib stream with fixed

@@ -16,6 +16,9 @@ TimingSummary summarize(std::vector<double> ms);
 
 /// Peak resident set size of this process in MB (getrusage).
 double peakRssMb();
+/// Current resident set size of this process in MB (VmRSS of /proc/self/status); NaN where unavailable.
+/// For memory-over-time logs: the peak alone cannot tell steady growth from one early spike.
+double currentRssMb();
 
 /// CPU time consumed by the calling thread, in seconds.
 double threadCpuSeconds();

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "laser_dpslam/pose2d.h"
@@ -17,6 +18,13 @@ struct StampedPose {
 /// never sees a partial file and an existing file survives a failed write. Throws std::runtime_error
 /// naming the path (and errno's text) on failure.
 void writeFileAtomically(const std::string& path, const std::string& content);
+
+/// Several files (path, content) that belong together: all are written to temporaries (and synced)
+/// first, then renamed in the given order. A failure while writing (no space, no permission, no
+/// directory) leaves every existing file untouched and no temporary behind; only a failing rename
+/// (e.g. the destination is a directory) can leave the files before it replaced. Throws
+/// std::runtime_error naming the path.
+void writeFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
 
 /// TUM text of a planar trajectory (z = 0, rotation about z), stamps with 9 decimals.
 std::string formatTum(const std::vector<StampedPose>& poses);

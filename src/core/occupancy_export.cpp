@@ -86,9 +86,9 @@ void writeMapServerFiles(const OccupancyGridData& grid, const std::string& yaml_
   if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) stem = stem.substr(0, dot);
   const std::string pgm_path = stem + ".pgm";
   const std::string image = slash == std::string::npos ? pgm_path : pgm_path.substr(slash + 1);
-  // The image first: a reader that finds the YAML also finds its image.
-  writeFileAtomically(pgm_path, formatPgm(grid));
-  writeFileAtomically(yaml_path, formatMapYaml(grid, image));
+  // Both written before either replaces anything, so a failure cannot pair a new image with an old YAML
+  // (different size and origin); renamed image first: a reader that finds the new YAML finds its image.
+  writeFilesAtomically({{pgm_path, formatPgm(grid)}, {yaml_path, formatMapYaml(grid, image)}});
 }
 
 // --- PNG -----------------------------------------------------------------------------------------

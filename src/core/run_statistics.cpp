@@ -26,6 +26,22 @@ double peakRssMb() {
   return ru.ru_maxrss / 1024.0;  // Linux reports KiB
 }
 
+double currentRssMb() {
+  FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return std::nan("");
+  char line[256];
+  double mb = std::nan("");
+  while (std::fgets(line, sizeof(line), f)) {
+    long kb = 0;
+    if (std::sscanf(line, "VmRSS: %ld kB", &kb) == 1) {
+      mb = kb / 1024.0;
+      break;
+    }
+  }
+  std::fclose(f);
+  return mb;
+}
+
 double threadCpuSeconds() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);

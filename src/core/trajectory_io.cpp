@@ -11,24 +11,59 @@
 
 namespace laser_dpslam {
 
-void writeFileAtomically(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error("cannot write '" + path + "': " + std::strerror(errno));
+namespace {
+
+/// Creates (or truncates) `path` and writes `content` to disk (flush + fsync). On failure returns false
+/// with errno's text in *error; *created says whether the file exists now (a partial file to remove).
+bool writeAndSync(const std::string& path, const std::string& content, bool* created, std::string* error) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  *created = f != nullptr;
+  if (!f) {
+    *error = std::strerror(errno);
+    return false;
+  }
   const bool written = std::fwrite(content.data(), 1, content.size(), f) == content.size();
   const int write_errno = errno;
-  const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
+  const bool flushed = written && std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
   const int flush_errno = errno;
   const bool closed = std::fclose(f) == 0;
-  if (!written || !flushed || !closed) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write '" + path + "': " +
-                             std::strerror(!written ? write_errno : (!flushed ? flush_errno : errno)));
+  const int close_errno = errno;
+  if (written && flushed && closed) return true;
+  *error = std::strerror(!written ? write_errno : (!flushed ? flush_errno : close_errno));
+  return false;
+}
+
+}  // namespace
+
+void writeFileAtomically(const std::string& path, const std::string& content) {
+  writeFilesAtomically({{path, content}});
+}
+
+void writeFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
+  // Every temporary is complete on disk before the first rename: running out of space or permission
+  // while writing any of them leaves all previous files as they were (a map's PGM and YAML stay a pair).
+  std::vector<std::string> temps;
+  auto discard = [&temps](std::size_t from) {
+    for (std::size_t k = from; k < temps.size(); ++k) std::remove(temps[k].c_str());
+  };
+  for (const auto& file : files) {
+    const std::string tmp = file.first + ".tmp." + std::to_string(::getpid());
+    bool created = false;
+    std::string error;
+    const bool ok = writeAndSync(tmp, file.second, &created, &error);
+    if (created) temps.push_back(tmp);  // only what this call created is removed
+    if (!ok) {
+      discard(0);
+      throw std::runtime_error("cannot write '" + file.first + "': " + error);
+    }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write '" + path + "': " + std::strerror(e));
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (std::rename(temps[i].c_str(), files[i].first.c_str()) != 0) {
+      const int e = errno;
+      discard(i);
+      throw std::runtime_error("cannot write '" + files[i].first + "': " + std::strerror(e) +
+                               (i > 0 ? " (the files listed before it were already replaced)" : ""));
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 #include <sensor_msgs/LaserScan.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -25,6 +26,7 @@
 #include "laser_dpslam/occupancy_export.h"
 #include "laser_dpslam/odometry_parameters.h"
 #include "laser_dpslam/parameter_source.h"
+#include "laser_dpslam/ros/bag_scan_reader.h"
 #include "laser_dpslam/ros/bag_tf.h"
 #include "laser_dpslam/ros/msg_conversion.h"
 #include "laser_dpslam/run_statistics.h"
@@ -38,7 +40,13 @@ namespace {
 const char* kUsage =
     "usage: dpslam_offline --bag IN.bag --out DIR [--scan-topic /scan] [--config FILE.yaml]... [--seed N]\n"
     "                      [--odometry-only] [--base-frame base_link] [--laser-pose X Y YAW] [--quiet]\n"
-    "                      [--match-log FILE.csv]   (one line per scan: the match's quality figures)\n";
+    "                      [--match-log FILE.csv]   (one line per scan: the match's quality figures)\n"
+    "                      [--memory-log FILE.csv]  (one line per scan: RSS, ancestry tree and map size)\n"
+    "                      [--loops N]              (replay the bag N times, as rosbag play -l would: time\n"
+    "                                               goes back at each loop and everything starts over)\n"
+    "Outputs are written at the end, stats.json last; a failed run (e.g. a corrupted bag) writes none.\n"
+    "When scan time goes backwards (a looped bag) the odometry and the SLAM start over, as the nodes\n"
+    "do, and the outputs describe the part after the last such reset.\n";
 
 struct Args {
   std::string bag, out, scan_topic = "/scan", base_frame = "base_link";
@@ -50,6 +58,8 @@ struct Args {
   double laser_pose[3] = {0, 0, 0};
   bool quiet = false;
   std::string match_log;
+  std::string memory_log;
+  int loops = 1;
 };
 
 [[noreturn]] void usageError(const std::string& what) {
@@ -85,6 +95,12 @@ Args parseArgs(int argc, char** argv) {
     } else if (f == "--odometry-only") a.odometry_only = true;
     else if (f == "--quiet") a.quiet = true;
     else if (f == "--match-log") a.match_log = next();
+    else if (f == "--memory-log") a.memory_log = next();
+    else if (f == "--loops") {
+      const double v = parseNumber(f, next());
+      if (v < 1 || v > 1e6 || v != std::floor(v)) usageError("--loops expects a positive integer");
+      a.loops = static_cast<int>(v);
+    }
     else if (f == "--laser-pose") {
       if (i + 3 >= argc) usageError("--laser-pose needs X Y YAW");
       for (double& v : a.laser_pose) v = parseNumber(f, argv[++i]);
@@ -142,28 +158,21 @@ int main(int argc, char** argv) {
   try {
     bag.open(args.bag, rosbag::bagmode::Read);
   } catch (const std::exception& e) {
-    std::cerr << "dpslam_offline: cannot read bag '" << args.bag << "': " << e.what() << "\n";
+    // A bag cut short (copy interrupted, recorder killed) has lost its index at the end.
+    std::cerr << "dpslam_offline: cannot read bag '" << args.bag << "': " << e.what()
+              << " (truncated, or still being recorded? `rosbag reindex` recovers the complete part)\n";
     return 1;
   }
 
-  // Accept the topic with or without its leading slash.
-  std::vector<std::string> topics{args.scan_topic};
-  if (!args.scan_topic.empty() && args.scan_topic[0] == '/') topics.push_back(args.scan_topic.substr(1));
-  else topics.push_back("/" + args.scan_topic);
-  // From time 0, not View's default TIME_MIN: logs without time (DP-SLAM) start at 0.
-  rosbag::View view(bag, rosbag::TopicQuery(topics), ros::Time(0, 0), ros::TIME_MAX);
-  const std::size_t total = view.size();
-  if (total == 0) {
-    std::set<std::string> scan_topics;
-    rosbag::View all(bag);
-    for (const auto* c : all.getConnections()) {
-      if (c->datatype == "sensor_msgs/LaserScan") scan_topics.insert(c->topic);
+  std::FILE* memory_log = nullptr;
+  if (!args.memory_log.empty()) {
+    // Streamed, not kept in memory: the log must not be the growth it measures.
+    memory_log = std::fopen(args.memory_log.c_str(), "w");
+    if (!memory_log) {
+      std::cerr << "dpslam_offline: cannot write '" << args.memory_log << "': " << std::strerror(errno) << "\n";
+      return 1;
     }
-    std::string list;
-    for (const auto& t : scan_topics) list += " " + t;
-    std::cerr << "dpslam_offline: no messages on " << args.scan_topic << " in '" << args.bag
-              << "'; LaserScan topics in the bag:" << (list.empty() ? " none" : list) << " (use --scan-topic)\n";
-    return 1;
+    std::fprintf(memory_log, "loop,scan,stamp,wall_s,rss_mb,tree_nodes,map_entries,slam_memory_mb\n");
   }
 
   const bool show_progress = !args.quiet && ::isatty(STDOUT_FILENO);
@@ -176,93 +185,161 @@ int main(int argc, char** argv) {
   bool slam_has_last = false;
   std::vector<double> slam_ms;
   DpSlamUpdate last_slam;
+  std::size_t max_tree_nodes = 0;
   LaserMount mount;
   bool mount_known = false;
   std::string laser_frame;
   std::vector<StampedPose> odom_poses;
   std::vector<double> odom_ms;
   std::map<std::string, int> skipped;
-  int matched = 0, bad = 0;
-  double first_stamp = 0.0, last_stamp = 0.0;
-  std::size_t done = 0;
+  int matched = 0, bad = 0, time_resets = 0;
+  bool have_stamp = false;
+  double first_stamp = 0.0, last_stamp = 0.0, previous_stamp = 0.0;
+  double earlier_segments = 0.0;  // s of data before the last time reset
+  std::size_t per_loop = 0, total = 0, done = 0;
+  // A new time line (time went backwards): the outputs restart, so does the SLAM's map.
+  auto start_over = [&](double from, double to) {
+    if (!odom_poses.empty()) earlier_segments += last_stamp - first_stamp;
+    if (!args.quiet && time_resets == 0) {
+      std::cerr << "dpslam_offline: warning: scan time went backwards (" << from << " -> " << to
+                << " s): odometry and SLAM start over; the outputs describe the part after the last reset\n";
+    }
+    ++time_resets;
+    odom_poses.clear();
+    if (slam) slam->reset();
+    slam_has_last = false;
+    slam_delta_cov.setZero();
+  };
   const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = processCpuSeconds();
 
-  for (const rosbag::MessageInstance& m : view) {
-    ++done;
-    sensor_msgs::LaserScan::ConstPtr msg = m.instantiate<sensor_msgs::LaserScan>();
-    if (!msg) {
-      ++skipped["not_a_laser_scan"];
-      continue;
-    }
-    if (!mount_known) {
-      laser_frame = cleanFrameId(msg->header.frame_id);
-      if (args.has_laser_pose) {
-        mount = LaserMount::fromPose(Pose2D(args.laser_pose[0], args.laser_pose[1], args.laser_pose[2]));
-      } else {
-        geometry_msgs::Transform t;
-        std::string error;
-        if (laser_frame == cleanFrameId(args.base_frame)) {
-          mount = LaserMount();
-        } else if (findBagTransform(bag, args.base_frame, laser_frame, &t, &error)) {
-          mount = mountFromTransform(t);
-        } else {
-          std::cerr << "dpslam_offline: warning: " << error << "; taking the laser to be at " << args.base_frame
-                    << " (use --laser-pose X Y YAW to override)\n";
-        }
+  try {
+    // Accept the topic with or without its leading slash.
+    std::vector<std::string> topics{args.scan_topic};
+    if (!args.scan_topic.empty() && args.scan_topic[0] == '/') topics.push_back(args.scan_topic.substr(1));
+    else topics.push_back("/" + args.scan_topic);
+    // From time 0, not View's default TIME_MIN: logs without time (DP-SLAM) start at 0.
+    rosbag::View view(bag, rosbag::TopicQuery(topics), ros::Time(0, 0), ros::TIME_MAX);
+    per_loop = view.size();
+    total = per_loop * static_cast<std::size_t>(args.loops);
+    if (total == 0) {
+      std::set<std::string> scan_topics;
+      rosbag::View all(bag);
+      for (const auto* c : all.getConnections()) {
+        if (c->datatype == "sensor_msgs/LaserScan") scan_topics.insert(c->topic);
       }
-      mount_known = true;
+      std::string list;
+      for (const auto& t : scan_topics) list += " " + t;
+      std::cerr << "dpslam_offline: no messages on " << args.scan_topic << " in '" << args.bag
+                << "'; LaserScan topics in the bag:" << (list.empty() ? " none" : list) << " (use --scan-topic)\n";
+      return 1;
     }
-    const LaserScan scan = fromMsg(*msg);
-    const double t0 = threadCpuSeconds();
-    const PreprocessedScan pre = preprocessScan(scan, pre_config);
-    const OdometryUpdate u = odometry.process(pre, mount);
-    const double ms = 1e3 * (threadCpuSeconds() - t0);
 
-    if (!args.match_log.empty()) {
-      char line[512];
-      std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g\n",
-                    scan.stamp, u.ok, u.skip_reason.c_str(), u.pose.x, u.pose.y, u.pose.theta, u.delta.x, u.delta.y,
-                    u.delta.theta, u.match.score_per_point, u.match.matched_fraction, u.match.degenerate, u.match.weak,
-                    u.match.de_generations, u.match.de_evaluations, u.match.newton_iterations, u.points_used,
-                    u.new_keyframe, ms, u.delta_covariance(0, 0), u.delta_covariance(1, 1), u.delta_covariance(2, 2));
-      match_log += line;
-    }
-    if (odom_poses.empty()) first_stamp = scan.stamp;
-    if (!u.ok) {
-      ++skipped[pre.ok() ? u.skip_reason : "malformed_scan"];
-      if (u.skip_reason == "time_backwards" || u.skip_reason == "duplicate_stamp" || !pre.ok()) {
+    for (int loop = 0; loop < args.loops; ++loop) {
+      for (const rosbag::MessageInstance& m : view) {
+        ++done;
+        sensor_msgs::LaserScan::ConstPtr msg = readLaserScan(m);
+        if (!msg) {
+          ++skipped["not_a_laser_scan"];
+          continue;
+        }
+        if (!mount_known) {
+          laser_frame = cleanFrameId(msg->header.frame_id);
+          if (args.has_laser_pose) {
+            mount = LaserMount::fromPose(Pose2D(args.laser_pose[0], args.laser_pose[1], args.laser_pose[2]));
+          } else {
+            geometry_msgs::Transform t;
+            std::string error;
+            if (laser_frame == cleanFrameId(args.base_frame)) {
+              mount = LaserMount();
+            } else if (findBagTransform(bag, args.base_frame, laser_frame, &t, &error)) {
+              mount = mountFromTransform(t);
+            } else {
+              std::cerr << "dpslam_offline: warning: " << error << "; taking the laser to be at " << args.base_frame
+                        << " (use --laser-pose X Y YAW to override)\n";
+            }
+          }
+          mount_known = true;
+        }
+        const LaserScan scan = fromMsg(*msg);
+        // Time went backwards (a looped bag): start over like dpslam_node, which resets the SLAM on any
+        // earlier stamp; the odometry resets itself. The outputs keep one monotonic time line.
+        if (have_stamp && scan.stamp < previous_stamp) start_over(previous_stamp, scan.stamp);
+        have_stamp = true;
+        previous_stamp = scan.stamp;
+        const double t0 = threadCpuSeconds();
+        const PreprocessedScan pre = preprocessScan(scan, pre_config);
+        const OdometryUpdate u = odometry.process(pre, mount);
+        const double ms = 1e3 * (threadCpuSeconds() - t0);
+
+        if (!args.match_log.empty()) {
+          char line[512];
+          std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g\n",
+                        scan.stamp, u.ok, u.skip_reason.c_str(), u.pose.x, u.pose.y, u.pose.theta, u.delta.x, u.delta.y,
+                        u.delta.theta, u.match.score_per_point, u.match.matched_fraction, u.match.degenerate, u.match.weak,
+                        u.match.de_generations, u.match.de_evaluations, u.match.newton_iterations, u.points_used,
+                        u.new_keyframe, ms, u.delta_covariance(0, 0), u.delta_covariance(1, 1), u.delta_covariance(2, 2));
+          match_log += line;
+        }
+        // The odometry restarted by its own time check (compared with the last scan it used): same thing.
+        if (u.reset && !odom_poses.empty()) start_over(odom_poses.back().stamp, scan.stamp);
+        if (odom_poses.empty()) first_stamp = scan.stamp;
+        if (!u.ok) {
+          ++skipped[pre.ok() ? u.skip_reason : "malformed_scan"];
+          if (u.skip_reason == "time_backwards" || u.skip_reason == "duplicate_stamp" || !pre.ok()) {
+            if (show_progress && done % 20 == 0) progress(done, total);
+            continue;
+          }
+        } else {
+          odom_ms.push_back(ms);
+          if (!u.reset) {
+            ++matched;
+            if (u.match.weak || u.match.degenerate) ++bad;
+          }
+        }
+        if (!odom_poses.empty() && scan.stamp <= odom_poses.back().stamp) {
+          // Not reached since the reset above (kept as a guard): the TUM files need a monotonic time line.
+          ++skipped["time_backwards"];
+          continue;
+        }
+        odom_poses.push_back({scan.stamp, u.pose});
+        last_stamp = scan.stamp;
+        if (slam) {
+          slam_delta_cov += u.delta_covariance;
+          const Pose2D delta = slam_has_last && !u.reset ? between(slam_last_odom, u.pose) : Pose2D();
+          const auto s0 = std::chrono::steady_clock::now();
+          last_slam = slam->process(scan.stamp, pre, mount, delta, slam_delta_cov);
+          // Wall time: the SLAM scores particles on several threads.
+          slam_ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count());
+          if (!last_slam.ok) ++skipped["slam_" + last_slam.skip_reason];
+          max_tree_nodes = std::max(max_tree_nodes, last_slam.tree_nodes);
+          slam_last_odom = u.pose;
+          slam_delta_cov.setZero();
+          slam_has_last = true;
+        }
+        if (memory_log) {
+          std::fprintf(memory_log, "%d,%zu,%.6f,%.3f,%.3f,%zu,%zu,%.3f\n", loop, done, scan.stamp,
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(), currentRssMb(),
+                       slam ? last_slam.tree_nodes : 0, slam ? last_slam.map_entries : 0,
+                       slam ? last_slam.memory_bytes / 1048576.0 : 0.0);
+        }
         if (show_progress && done % 20 == 0) progress(done, total);
-        continue;
-      }
-    } else {
-      odom_ms.push_back(ms);
-      if (!u.reset) {
-        ++matched;
-        if (u.match.weak || u.match.degenerate) ++bad;
       }
     }
-    if (!odom_poses.empty() && scan.stamp <= odom_poses.back().stamp) {
-      // Time went backwards: the odometry restarted; the TUM file keeps a monotonic time line.
-      ++skipped["time_backwards"];
-      continue;
-    }
-    odom_poses.push_back({scan.stamp, u.pose});
-    last_stamp = scan.stamp;
-    if (slam) {
-      if (u.reset && slam_has_last) slam->reset();  // the odometry restarted: so does the map
-      slam_delta_cov += u.delta_covariance;
-      const Pose2D delta = slam_has_last && !u.reset ? between(slam_last_odom, u.pose) : Pose2D();
-      const auto s0 = std::chrono::steady_clock::now();
-      last_slam = slam->process(scan.stamp, pre, mount, delta, slam_delta_cov);
-      // Wall time: the SLAM scores particles on several threads.
-      slam_ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count());
-      if (!last_slam.ok) ++skipped["slam_" + last_slam.skip_reason];
-      slam_last_odom = u.pose;
-      slam_delta_cov.setZero();
-      slam_has_last = true;
-    }
-    if (show_progress && done % 20 == 0) progress(done, total);
+  } catch (const std::exception& e) {
+    // rosbag's exceptions for damaged chunks, readLaserScan's for damaged records. Nothing is written:
+    // outputs of part of a bag would look like the result of the whole.
+    if (show_progress) std::fprintf(stdout, "\n");
+    std::cerr << "dpslam_offline: error reading bag '" << args.bag << "'";
+    if (per_loop > 0) std::cerr << " at scan message " << (done - 1) % per_loop + 1 << " of " << per_loop;
+    std::cerr << ": " << e.what()
+              << "; the bag is damaged, no outputs written (`rosbag check` / `rosbag reindex` may help)\n";
+    if (memory_log) std::fclose(memory_log);
+    return 1;
+  }
+  if (memory_log && std::fclose(memory_log) != 0) {
+    std::cerr << "dpslam_offline: cannot write '" << args.memory_log << "': " << std::strerror(errno) << "\n";
+    return 1;
   }
   if (show_progress) {
     progress(done, total);
@@ -270,7 +347,7 @@ int main(int argc, char** argv) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = processCpuSeconds() - cpu0;
-  const double duration = last_stamp - first_stamp;
+  const double duration = earlier_segments + (odom_poses.empty() ? 0.0 : last_stamp - first_stamp);
 
   try {
     writeFileAtomically(args.out + "/odometry.tum", formatTum(odom_poses));
@@ -294,6 +371,7 @@ int main(int argc, char** argv) {
     json += "  \"particles\": " + std::to_string(slam ? slam_config.particles : 0) + ",\n";
     if (slam) {
       json += "  \"tree_nodes\": " + std::to_string(last_slam.tree_nodes) + ",\n";
+      json += "  \"tree_nodes_max\": " + std::to_string(max_tree_nodes) + ",\n";
       json += "  \"map_entries\": " + std::to_string(last_slam.map_entries) + ",\n";
       json += "  \"slam_memory_mb\": " + jsonNumber(last_slam.memory_bytes / 1048576.0) + ",\n";
     }
@@ -301,7 +379,10 @@ int main(int argc, char** argv) {
     json += "  \"bad_match_percent\": " + jsonNumber(matched ? 100.0 * bad / matched : 0.0) + ",\n";
     json += "  \"resampling\": " + jsonString(resamplingMethodName(odom_config.resampling)) + ",\n";
     json += std::string("  \"mode\": ") + (slam ? "\"slam\"" : "\"odometry-only\"") + ",\n";
+    json += "  \"loops\": " + std::to_string(args.loops) + ",\n";
+    json += "  \"time_resets\": " + std::to_string(time_resets) + ",\n";
     json += "  \"skipped\": " + jsonCounts(skipped) + "\n}\n";
+    // Last: a stats.json means the run completed and every other output was written.
     writeFileAtomically(args.out + "/stats.json", json);
   } catch (const std::exception& e) {
     std::cerr << "dpslam_offline: " << e.what() << "\n";

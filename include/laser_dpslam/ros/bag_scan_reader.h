@@ -1,0 +1,25 @@
+// LaserScans read from a bag with their size checked before ROS deserializes them: a corrupted array
+// length in a bag record makes the generated deserializer resize a vector to billions of floats (it
+// checks the buffer only afterwards), which on a small robot computer means swapping or the OOM killer
+// instead of an error message.
+#pragma once
+
+#include <rosbag/message_instance.h>
+#include <sensor_msgs/LaserScan.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace laser_dpslam {
+
+/// True when `size` bytes hold exactly one serialized sensor_msgs/LaserScan: every string and array
+/// length fits in what is left and nothing is left over. Otherwise false, with what is wrong in *why.
+bool serializedLaserScanFits(const std::uint8_t* data, std::size_t size, std::string* why);
+
+/// The bag message as a LaserScan; nullptr when it is of another type. Throws std::runtime_error saying
+/// what is corrupted when the record does not hold a well-formed LaserScan (rosbag's own exceptions,
+/// e.g. for a damaged chunk, pass through).
+sensor_msgs::LaserScan::Ptr readLaserScan(const rosbag::MessageInstance& m);
+
+}  // namespace laser_dpslam
