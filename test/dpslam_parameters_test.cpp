@@ -71,6 +71,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.beam.log_floor, d.beam.log_floor);
   EXPECT_EQ(c.beam.unknown_mean_free_path, d.beam.unknown_mean_free_path);
   EXPECT_EQ(c.score_beam_step, d.score_beam_step);
+  EXPECT_EQ(c.likelihood_weight, d.likelihood_weight);
   EXPECT_EQ(c.score_no_return, d.score_no_return);
   EXPECT_EQ(c.min_points, d.min_points);
   EXPECT_EQ(c.occupancy_stop_length, d.occupancy_stop_length);

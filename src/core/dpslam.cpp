@@ -47,6 +47,7 @@ void DpSlamConfig::validate() const {
   require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
   require(map_update_distance >= 0.0 && map_update_angle >= 0.0, "map update thresholds must be >= 0");
   require(beam.sigma > 0.0, "beam_sigma must be > 0");
+  require(likelihood_weight > 0.0 && likelihood_weight <= 1.0, "likelihood_weight must be in (0, 1]");
   require(beam.window > 0.0, "beam_window must be > 0");
   require(beam.log_floor < 0.0, "beam_log_floor must be < 0");
   require(beam.unknown_mean_free_path > 0.0, "unknown_mean_free_path must be > 0");
@@ -300,7 +301,12 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
     // 3. Weights: the full observation model, one result per particle (independent of scheduling).
     pool_->run(P, [&](std::size_t i, int w) { ll[i] = score(chosen[i], static_cast<int>(i), caches_[w]); });
   }
-  for (int i = 0; i < P; ++i) logw_[i] += ll[i];
+  // Tempering: beams are not independent, so the product of their likelihoods is over-confident and
+  // depletes the particles; an exponent < 1 keeps more hypotheses alive until a loop closes.
+  for (int i = 0; i < P; ++i) {
+    ll[i] *= config_.likelihood_weight;
+    logw_[i] += ll[i];
+  }
   u.score_spread = *std::max_element(ll.begin(), ll.end()) - *std::min_element(ll.begin(), ll.end());
   const NormalizedWeights nw = normalizeLogWeights(logw_);
   // 4. Neff-gated low-variance resampling.

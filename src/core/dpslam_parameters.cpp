@@ -61,6 +61,9 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   if (s.get("beam_log_floor", c.beam.log_floor)) require(c.beam.log_floor < 0.0, "beam_log_floor", c.beam.log_floor, "must be < 0");
   positive(s, "unknown_mean_free_path", c.beam.unknown_mean_free_path);
   atLeast(s, "score_beam_step", c.score_beam_step, 1);
+  if (s.get("likelihood_weight", c.likelihood_weight)) {
+    require(c.likelihood_weight > 0.0 && c.likelihood_weight <= 1.0, "likelihood_weight", c.likelihood_weight, "must be in (0, 1]");
+  }
   s.get("score_no_return", c.score_no_return);
   atLeast(s, "slam_min_points", c.min_points, 1);
 
