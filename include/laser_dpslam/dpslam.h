@@ -50,7 +50,7 @@ struct DpSlamConfig {
   // --- Observation model ---
   BeamModelConfig beam;         ///< sigma, window, log floor, unknown mean free path
   int score_beam_step = 4;      ///< every k-th beam is scored (tempering and speed)
-  double likelihood_weight = 1.0;  ///< exponent of a scan's likelihood in the weights (tempering, 0–1]
+  double likelihood_weight = 0.5;  ///< exponent of a scan's likelihood in the weights (tempering, 0–1]
   bool score_no_return = true;  ///< no-return beams are scored too (free space up to the range)
   int min_points = 20;          ///< fewer valid returns: the scan is not used (particles still move)
   // --- Output ---
