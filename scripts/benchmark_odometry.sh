@@ -13,16 +13,8 @@ fi
 OUT="$REPO/out/benchmark"
 mkdir -p "$OUT"
 
-convert() {  # format input output
-  [[ -f "$3" && "$3" -nt "$2" ]] || rosrun laser_dpslam log_to_bag --format "$1" "$2" "$3" > /dev/null
-}
-declare -A BAGS
-if [[ -f "$DATA/mit-csail/mit-csail.clf" ]]; then convert carmen "$DATA/mit-csail/mit-csail.clf" "$OUT/mit-csail.bag"; BAGS[mit-csail]="$OUT/mit-csail.bag"; fi
-for e in exp1 exp2; do
-  if [[ -f "$DATA/urg04lx-mines/$e.dat" ]]; then convert mines "$DATA/urg04lx-mines/$e.dat" "$OUT/mines-$e.bag"; BAGS[mines-$e]="$OUT/mines-$e.bag"; fi
-done
-if [[ -f "$DATA/dpslam-loop5/loop5.log" ]]; then convert dpslam "$DATA/dpslam-loop5/loop5.log" "$OUT/loop5.bag"; BAGS[loop5]="$OUT/loop5.bag"; fi
-if [[ -f "$DATA/scan_tools-demo/laser_scan_matcher_demo.bag" ]]; then BAGS[scan_tools-demo]="$DATA/scan_tools-demo/laser_scan_matcher_demo.bag"; fi
+# shellcheck source=datasets.sh
+source "$REPO/scripts/datasets.sh"
 
 printf "%-16s %-9s %6s %9s %9s %8s %7s %s\n" dataset resampling scans "med ms" "p95 ms" "RT x" "bad %" "relations (<=10 s | all): trans m / rot deg"
 for name in $(printf "%s\n" "${!BAGS[@]}" | sort); do

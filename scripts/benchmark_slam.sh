@@ -13,21 +13,14 @@ DATA="${1:-$REPO/../shared/datasets}"
 OUT="$REPO/out/benchmark_slam"
 mkdir -p "$OUT"
 
-convert() {  # format input output
-  [[ -f "$3" && "$3" -nt "$2" ]] || rosrun laser_dpslam log_to_bag --format "$1" "$2" "$3" > /dev/null
-}
 declare -A BAGS
-BAGS[demo]="$REPO/bags/demo.bag"
 if [[ -d "$DATA" ]]; then
-  if [[ -f "$DATA/mit-csail/mit-csail.clf" ]]; then convert carmen "$DATA/mit-csail/mit-csail.clf" "$OUT/mit-csail.bag"; BAGS[mit-csail]="$OUT/mit-csail.bag"; fi
-  for e in exp1 exp2; do
-    if [[ -f "$DATA/urg04lx-mines/$e.dat" ]]; then convert mines "$DATA/urg04lx-mines/$e.dat" "$OUT/mines-$e.bag"; BAGS[mines-$e]="$OUT/mines-$e.bag"; fi
-  done
-  if [[ -f "$DATA/dpslam-loop5/loop5.log" ]]; then convert dpslam "$DATA/dpslam-loop5/loop5.log" "$OUT/loop5.bag"; BAGS[loop5]="$OUT/loop5.bag"; fi
-  if [[ -f "$DATA/scan_tools-demo/laser_scan_matcher_demo.bag" ]]; then BAGS[scan_tools-demo]="$DATA/scan_tools-demo/laser_scan_matcher_demo.bag"; fi
+  # shellcheck source=datasets.sh
+  source "$REPO/scripts/datasets.sh"
 else
   echo "no datasets at $DATA: only the bundled demo" >&2
 fi
+BAGS[demo]="$REPO/bags/demo.bag"
 
 printf "%-16s %5s %6s %8s %8s %6s %7s %6s  %s\n" dataset P scans "slam ms" "p95 ms" "RT x" "RSS MB" "tree" "error"
 for name in $(printf "%s\n" "${!BAGS[@]}" | sort); do
