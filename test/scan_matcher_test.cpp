@@ -110,6 +110,35 @@ TEST(ScanMatcher, CorridorIsFlaggedDegenerateWithLargeVarianceAlongIt) {
   EXPECT_GT(std::sqrt(r2.covariance(0, 0)), 0.001);
 }
 
+// The soft motion prior (prior_sigma_xy): along a corridor, where the scan says nothing, the result
+// stays at the prior; in a room, where the scan constrains the pose, a prior 5 cm off does not pull it.
+TEST(ScanMatcher, SoftPriorHoldsTheCorridorDirectionAndYieldsToTheData) {
+  const FloorPlan corridor = test::planFromBoxes(40.0, 3.0, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.9, 40.0, 3.0}});
+  ScanSimulator sim(corridor, ScanSimulatorConfig(), 5);
+  ScanMatcher m;
+  m.setReference(scanAt(sim, Pose2D(20.0, 1.5, 0.0)));
+  const auto pts = scanAt(sim, Pose2D(20.1, 1.5, 0.0));
+  const Pose2D prior(0.08, 0.0, 0.0);  // the motion the constant-velocity model predicts
+  std::mt19937_64 rng(2);
+  const MatchResult held = m.match(pts, pts, prior, rng, 0.01);
+  ASSERT_TRUE(held.valid);
+  EXPECT_NEAR(held.pose.x, prior.x, 0.005);  // the flat direction follows the prior
+  EXPECT_LT(std::abs(held.pose.y), 0.01);    // the constrained one follows the walls
+
+  const FloorPlan room = test::furnishedRoom();
+  ScanSimulator sim2(room, ScanSimulatorConfig(), 6);
+  ScanMatcher m2;
+  m2.setReference(scanAt(sim2, Pose2D(3, 3, 0)));
+  const auto pts2 = scanAt(sim2, Pose2D(3.05, 3, 0.02));
+  std::mt19937_64 rng2(3);
+  const MatchResult free_match = m2.match(pts2, pts2, Pose2D(0.05, 0.0, 0.02), rng2, 0.0);
+  std::mt19937_64 rng3(3);
+  const MatchResult with_prior = m2.match(pts2, pts2, Pose2D(0.10, 0.05, 0.02), rng3, 0.01);
+  ASSERT_TRUE(free_match.valid && with_prior.valid);
+  EXPECT_NEAR(with_prior.pose.x, free_match.pose.x, 0.01);
+  EXPECT_NEAR(with_prior.pose.y, free_match.pose.y, 0.01);
+}
+
 TEST(ScanMatcher, SameSeedGivesTheSameResult) {
   const FloorPlan room = test::furnishedRoom();
   ScanSimulator sim(room, ScanSimulatorConfig(), 8);
