@@ -48,6 +48,10 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.particles, d.particles);
   EXPECT_EQ(c.oversampling, d.oversampling);
   EXPECT_EQ(c.cull_window, d.cull_window);
+  EXPECT_EQ(c.refine_iterations, d.refine_iterations);
+  EXPECT_EQ(c.refine_step_xy, d.refine_step_xy);
+  EXPECT_EQ(c.refine_step_theta, d.refine_step_theta);
+  EXPECT_EQ(c.refine_halvings, d.refine_halvings);
   EXPECT_EQ(c.resample_threshold, d.resample_threshold);
   EXPECT_EQ(c.proposal.covariance_scale, d.proposal.covariance_scale);
   EXPECT_EQ(c.proposal.min_sigma_xy, d.proposal.min_sigma_xy);
