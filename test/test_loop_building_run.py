@@ -4,12 +4,14 @@ have few features in range; the old hard 'keep the prior when degenerate' rule e
 import math
 import os
 import subprocess
+import sys
 import tempfile
 import unittest
 
 import numpy as np
 
-from test_demo_run import PKG, load_tum, relative
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # nosetests under catkin does not add it
+from test_demo_run import PKG, load_tum, relative  # noqa: E402
 
 
 class LoopBuildingRunTest(unittest.TestCase):
