@@ -1,17 +1,14 @@
 """Regression on the corridors of plans/loop_building (one simulated lap, 88 m, URG-04LX with 5.6 m range):
 the laser odometry must stay within 1 % of the distance travelled (issue 4's acceptance). Its corridors
 have few features in range; the old hard 'keep the prior when degenerate' rule ended 44 m off here."""
-import math
 import os
 import subprocess
 import sys
 import tempfile
 import unittest
 
-import numpy as np
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # nosetests under catkin does not add it
-from test_demo_run import PKG, load_tum, relative  # noqa: E402
+from test_demo_run import PKG, path_errors  # noqa: E402
 
 
 class LoopBuildingRunTest(unittest.TestCase):
@@ -24,17 +21,13 @@ class LoopBuildingRunTest(unittest.TestCase):
         run = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", os.path.join(out, "sim.bag"),
                               "--out", out, "--odometry-only", "--quiet"], capture_output=True, text=True)
         self.assertEqual(run.returncode, 0, run.stderr)
-        t, x, y, th = load_tum(os.path.join(out, "odometry.tum"))
-        gt, gx, gy, gth = load_tum(os.path.join(out, "ground_truth.tum"))
-        self.assertEqual(len(t), len(gt))
-        ex, ey = relative(x, y, th)
-        rx, ry = relative(gx, gy, gth)
-        travelled = np.sum(np.hypot(np.diff(rx), np.diff(ry)))
-        final = math.hypot(ex[-1] - rx[-1], ey[-1] - ry[-1])
+        n, n_truth, travelled, final, worst = path_errors(os.path.join(out, "odometry.tum"),
+                                                          os.path.join(out, "ground_truth.tum"))
+        self.assertEqual(n, n_truth)
         self.assertGreater(travelled, 80.0)
         self.assertLess(final, 0.01 * travelled)  # 0.60 m of 88.4 m when measured (2026-11-29)
         # A lap ends where it started, so errors can cancel at the end: bound the whole path too.
-        self.assertLess(np.max(np.hypot(ex - rx, ey - ry)), 1.5)  # 0.66 m when measured
+        self.assertLess(worst, 1.5)  # 0.66 m when measured
 
 
 if __name__ == "__main__":

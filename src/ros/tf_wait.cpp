@@ -2,9 +2,9 @@
 
 #include <ros/duration.h>
 #include <ros/time.h>
+#include <tf2/exceptions.h>
 
 #include <algorithm>
-#include <tf2/exceptions.h>
 
 namespace laser_dpslam {
 
