@@ -45,6 +45,35 @@ void putLength(std::uint8_t* at, std::uint32_t n) {
 
 }  // namespace
 
+TEST(BagScanReader, AcceptsExactlyOneWellFormedTfMessage) {
+  tf2_msgs::TFMessage tf;
+  for (const char* child : {"laser", "imu"}) {
+    geometry_msgs::TransformStamped t;
+    t.header.frame_id = "base_link";
+    t.child_frame_id = child;
+    t.transform.rotation.w = 1.0;
+    tf.transforms.push_back(t);
+  }
+  std::vector<std::uint8_t> b(ros::serialization::serializationLength(tf));
+  ros::serialization::OStream out(b.data(), static_cast<std::uint32_t>(b.size()));
+  ros::serialization::serialize(out, tf);
+  std::string why;
+  ASSERT_TRUE(serializedTfMessageFits(b.data(), b.size(), &why)) << why;
+  for (std::size_t n = 0; n < b.size(); ++n) EXPECT_FALSE(serializedTfMessageFits(b.data(), n, &why)) << n;
+  b.push_back(0);
+  EXPECT_FALSE(serializedTfMessageFits(b.data(), b.size(), &why));
+  EXPECT_NE(why.find("left over"), std::string::npos) << why;
+  b.pop_back();
+  // A corrupted transform count or string length is reported instead of being believed.
+  putLength(&b[0], 20000000u);
+  EXPECT_FALSE(serializedTfMessageFits(b.data(), b.size(), &why));
+  EXPECT_NE(why.find("20000000 transforms do not fit"), std::string::npos) << why;
+  putLength(&b[0], 2u);
+  putLength(&b[16], 0xFFFFFFF0u);  // the first frame_id's length (after the count, seq and stamp)
+  EXPECT_FALSE(serializedTfMessageFits(b.data(), b.size(), &why));
+  EXPECT_NE(why.find("frame_id length"), std::string::npos) << why;
+}
+
 TEST(BagScanReader, AcceptsExactlyOneWellFormedScan) {
   std::vector<std::uint8_t> b = serialize(urgScan(1.0));
   std::string why;

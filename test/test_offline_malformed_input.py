@@ -2,6 +2,7 @@
 outputs, so that nothing looks like the result of a complete run."""
 import os
 import re
+import resource
 import shutil
 import subprocess
 import tempfile
@@ -71,6 +72,27 @@ class OfflineMalformedInputTest(unittest.TestCase):
         err = self.run_offline(self.write_bag(bytes(data)))
         self.assertIn("scan message 201 of 981", err)
         self.assertIn("damaged", err)
+
+    def test_corrupted_transform_count_in_tf_static(self):
+        # The demo's one /tf_static record (count, seq, stamp, then frame 'base_link' and child 'laser'):
+        # its transform count becomes 20 million. The record is skipped with a warning naming it (no
+        # gigabytes allocated for it); the run goes on with the laser at base_link, as for a bag without TF.
+        key = b"\x09\x00\x00\x00base_link\x05\x00\x00\x00laser"
+        starts = [m.start() for m in re.finditer(re.escape(key), self.demo)]
+        self.assertEqual(len(starts), 1)
+        at = starts[0] - 16
+        self.assertEqual(self.demo[at:at + 4], (1).to_bytes(4, "little"))
+        data = bytearray(self.demo)
+        data[at:at + 4] = (20000000).to_bytes(4, "little")
+        out = os.path.join(self.dir, "tf")
+        p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", self.write_bag(bytes(data)), "--out", out,
+                            "--quiet", "--odometry-only"], capture_output=True, text=True, timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("skipped 1 damaged TF record(s), the first /tf_static", p.stderr)
+        self.assertIn("20000000 transforms do not fit", p.stderr)
+        self.assertTrue(os.path.exists(os.path.join(out, "odometry.tum")))
+        # Peak memory of every child so far (kB): deserializing that record used to take 2.7 GB.
+        self.assertLess(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, 1 << 20)
 
     def test_the_intact_bag_still_runs(self):
         # The same helpers on the untouched bag: the failures above come from the damage, not the set-up.

@@ -48,6 +48,29 @@ bool serializedLaserScanFits(const std::uint8_t* data, std::size_t size, std::st
   return true;
 }
 
+bool serializedTfMessageFits(const std::uint8_t* data, std::size_t size, std::string* why) {
+  // tf2_msgs/TFMessage: geometry_msgs/TransformStamped[] — each a header (uint32 seq, time, string
+  // frame_id), string child_frame_id and 7 float64 (translation, rotation).
+  std::size_t at = 0;
+  std::uint64_t count = 0, n = 0;
+  auto fail = [&](const std::string& what) {
+    if (why) *why = what + " (record of " + std::to_string(size) + " bytes)";
+    return false;
+  };
+  if (!readLength(data, size, &at, &count)) return fail("transform count cut short");
+  // Each transform takes at least 76 bytes: a count that cannot fit is corruption, caught before any
+  // transform is read (and before a deserializer would allocate for it).
+  if (count > (size - at) / 76) return fail(std::to_string(count) + " transforms do not fit");
+  for (std::uint64_t i = 0; i < count; ++i) {
+    if (!skip(size, &at, 1, 12)) return fail("header cut short");
+    if (!readLength(data, size, &at, &n) || !skip(size, &at, n, 1)) return fail("frame_id length " + std::to_string(n) + " does not fit");
+    if (!readLength(data, size, &at, &n) || !skip(size, &at, n, 1)) return fail("child_frame_id length " + std::to_string(n) + " does not fit");
+    if (!skip(size, &at, 7, 8)) return fail("transform cut short");
+  }
+  if (at != size) return fail(std::to_string(size - at) + " bytes left over after the message");
+  return true;
+}
+
 sensor_msgs::LaserScan::Ptr readLaserScan(const rosbag::MessageInstance& m) {
   if (!m.isType<sensor_msgs::LaserScan>()) return nullptr;
   const std::uint32_t size = m.size();

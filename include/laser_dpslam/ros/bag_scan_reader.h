@@ -17,6 +17,9 @@ namespace laser_dpslam {
 /// length fits in what is left and nothing is left over. Otherwise false, with what is wrong in *why.
 bool serializedLaserScanFits(const std::uint8_t* data, std::size_t size, std::string* why);
 
+/// The same for one serialized tf2_msgs/TFMessage (the bag's /tf_static and /tf records).
+bool serializedTfMessageFits(const std::uint8_t* data, std::size_t size, std::string* why);
+
 /// The bag message as a LaserScan; nullptr when it is of another type. Throws std::runtime_error saying
 /// what is corrupted when the record does not hold a well-formed LaserScan (rosbag's own exceptions,
 /// e.g. for a damaged chunk, pass through).
