@@ -71,21 +71,36 @@ bool serializedTfMessageFits(const std::uint8_t* data, std::size_t size, std::st
   return true;
 }
 
-sensor_msgs::LaserScan::Ptr readLaserScan(const rosbag::MessageInstance& m) {
-  if (!m.isType<sensor_msgs::LaserScan>()) return nullptr;
+namespace {
+
+/// Reads, checks (`fits`) and deserializes one record of type M; `name` goes into the error message.
+template <class M>
+boost::shared_ptr<M> readChecked(const rosbag::MessageInstance& m, const char* name,
+                                 bool (*fits)(const std::uint8_t*, std::size_t, std::string*)) {
+  if (!m.isType<M>()) return nullptr;
   const std::uint32_t size = m.size();
-  // Far above any real scan (a million beams with intensities is 8 MB): a larger record is corruption.
+  // Far above any real scan (a million beams with intensities is 8 MB) or TF message: larger is corruption.
   constexpr std::uint32_t kMaxBytes = 64u << 20;
-  if (size > kMaxBytes) throw std::runtime_error("corrupted LaserScan record: " + std::to_string(size) + " bytes");
+  if (size > kMaxBytes) throw std::runtime_error(std::string("corrupted ") + name + " record: " + std::to_string(size) + " bytes");
   std::vector<std::uint8_t> buffer(size);
   ros::serialization::OStream out(buffer.data(), size);
   m.write(out);
   std::string why;
-  if (!serializedLaserScanFits(buffer.data(), buffer.size(), &why)) throw std::runtime_error("corrupted LaserScan record: " + why);
-  auto msg = boost::make_shared<sensor_msgs::LaserScan>();
+  if (!fits(buffer.data(), buffer.size(), &why)) throw std::runtime_error(std::string("corrupted ") + name + " record: " + why);
+  auto msg = boost::make_shared<M>();
   ros::serialization::IStream in(buffer.data(), size);
   ros::serialization::deserialize(in, *msg);
   return msg;
+}
+
+}  // namespace
+
+sensor_msgs::LaserScan::Ptr readLaserScan(const rosbag::MessageInstance& m) {
+  return readChecked<sensor_msgs::LaserScan>(m, "LaserScan", serializedLaserScanFits);
+}
+
+tf2_msgs::TFMessage::Ptr readTfMessage(const rosbag::MessageInstance& m) {
+  return readChecked<tf2_msgs::TFMessage>(m, "TFMessage", serializedTfMessageFits);
 }
 
 }  // namespace laser_dpslam

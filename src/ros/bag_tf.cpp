@@ -4,12 +4,8 @@
 #include <tf2/LinearMath/Transform.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include <ros/serialization.h>
-
-#include <cstdint>
 #include <map>
 #include <set>
-#include <vector>
 
 #include "laser_dpslam/ros/bag_scan_reader.h"
 #include "laser_dpslam/ros/msg_conversion.h"
@@ -33,24 +29,16 @@ bool findBagTransform(rosbag::Bag& bag, const std::string& parent, const std::st
   int damaged = 0;
   std::string damage;
   for (const rosbag::MessageInstance& m : view) {
-    if (!m.isType<tf2_msgs::TFMessage>()) continue;
-    // Checked before deserializing: a corrupted array length would make the deserializer allocate (and
-    // fill) gigabytes. A damaged record is skipped; the others may still hold the transform.
-    tf2_msgs::TFMessage::Ptr msg(new tf2_msgs::TFMessage);
+    // Checked before deserializing (a corrupted array length would make the deserializer allocate and
+    // fill gigabytes); a damaged record is skipped: the others may still hold the transform.
+    tf2_msgs::TFMessage::Ptr msg;
     try {
-      const std::uint32_t size = m.size();
-      if (size > (64u << 20)) throw std::runtime_error(std::to_string(size) + " bytes");
-      std::vector<std::uint8_t> buffer(size);
-      ros::serialization::OStream out(buffer.data(), size);
-      m.write(out);
-      std::string why;
-      if (!serializedTfMessageFits(buffer.data(), buffer.size(), &why)) throw std::runtime_error(why);
-      ros::serialization::IStream in(buffer.data(), size);
-      ros::serialization::deserialize(in, *msg);
+      msg = readTfMessage(m);
     } catch (const std::exception& e) {
       if (damaged++ == 0) damage = m.getTopic() + " at " + std::to_string(m.getTime().toSec()) + " s: " + e.what();
       continue;
     }
+    if (!msg) continue;
     for (const auto& t : msg->transforms) {
       const std::string tp = cleanFrameId(t.header.frame_id), tc = cleanFrameId(t.child_frame_id);
       frames.insert(tp);

@@ -1,4 +1,4 @@
-// LaserScans read from a bag with their size checked before ROS deserializes them: a corrupted array
+// LaserScans (and TF messages) read from a bag with their size checked before ROS deserializes them: a corrupted array
 // length in a bag record makes the generated deserializer resize a vector to billions of floats (it
 // checks the buffer only afterwards), which on a small robot computer means swapping or the OOM killer
 // instead of an error message.
@@ -6,6 +6,7 @@
 
 #include <rosbag/message_instance.h>
 #include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -24,5 +25,8 @@ bool serializedTfMessageFits(const std::uint8_t* data, std::size_t size, std::st
 /// what is corrupted when the record does not hold a well-formed LaserScan (rosbag's own exceptions,
 /// e.g. for a damaged chunk, pass through).
 sensor_msgs::LaserScan::Ptr readLaserScan(const rosbag::MessageInstance& m);
+
+/// The same for a tf2_msgs/TFMessage record.
+tf2_msgs::TFMessage::Ptr readTfMessage(const rosbag::MessageInstance& m);
 
 }  // namespace laser_dpslam
