@@ -44,7 +44,7 @@ for i in range(len(t)):
     if g.max() > worst: worst, at = g.max(), t[i] - t[0]
 print("%.2f m at %.0f s" % (worst, at))
 '
-ate() {  # estimate reference -> "ATE drift"
+ate() {  # estimate reference -> "ATE-RMSE drift-% distance-m"
   rosrun laser_dpslam evaluate_trajectory --estimate "$1" --reference "$2" |
     /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); print("%.3f %.2f %.1f" % (d["ate_rmse_m"], d["drift_percent"], d["distance_m"]))'
 }

@@ -28,6 +28,12 @@ class OfflineMalformedInputTest(unittest.TestCase):
             f.write(data)
         return path
 
+    def patched_bag(self, at, value):
+        """The demo bag with the little-endian uint32 at byte `at` replaced by `value`."""
+        data = bytearray(self.demo)
+        data[at:at + 4] = value.to_bytes(4, "little")
+        return self.write_bag(bytes(data))
+
     def run_offline(self, bag):
         out = os.path.join(self.dir, "out")
         # A timeout: a corrupted array length used to make the deserializer allocate gigabytes for minutes.
@@ -53,9 +59,7 @@ class OfflineMalformedInputTest(unittest.TestCase):
     def test_corrupted_array_length_in_a_scan(self):
         offsets = self.scan_ranges_length_offsets()
         self.assertGreater(len(offsets), 100)  # the demo bag is uncompressed: its records can be patched
-        data = bytearray(self.demo)
-        data[offsets[100]:offsets[100] + 4] = (0x7FFFFFFF).to_bytes(4, "little")
-        err = self.run_offline(self.write_bag(bytes(data)))
+        err = self.run_offline(self.patched_bag(offsets[100], 0x7FFFFFFF))
         self.assertIn("corrupted LaserScan record: ranges length 2147483647", err)
         self.assertIn("scan message 101 of 981", err)
 
@@ -67,9 +71,7 @@ class OfflineMalformedInputTest(unittest.TestCase):
         starts = [m.start() for m in re.finditer(re.escape(field), self.demo)
                   if self.demo[m.start() + 41:m.start() + 50] == b"\x05\x00\x00\x00laser"]
         self.assertEqual(len(starts), 981)
-        data = bytearray(self.demo)
-        data[starts[200]:starts[200] + 4] = (0xFFFFFF00).to_bytes(4, "little")
-        err = self.run_offline(self.write_bag(bytes(data)))
+        err = self.run_offline(self.patched_bag(starts[200], 0xFFFFFF00))
         self.assertIn("scan message 201 of 981", err)
         self.assertIn("damaged", err)
 
@@ -82,10 +84,8 @@ class OfflineMalformedInputTest(unittest.TestCase):
         self.assertEqual(len(starts), 1)
         at = starts[0] - 16
         self.assertEqual(self.demo[at:at + 4], (1).to_bytes(4, "little"))
-        data = bytearray(self.demo)
-        data[at:at + 4] = (20000000).to_bytes(4, "little")
         out = os.path.join(self.dir, "tf")
-        p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", self.write_bag(bytes(data)), "--out", out,
+        p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", self.patched_bag(at, 20000000), "--out", out,
                             "--quiet", "--odometry-only"], capture_output=True, text=True, timeout=120)
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertIn("skipped 1 damaged TF record(s), the first /tf_static", p.stderr)

@@ -1,7 +1,7 @@
-// LaserScans (and TF messages) read from a bag with their size checked before ROS deserializes them: a corrupted array
-// length in a bag record makes the generated deserializer resize a vector to billions of floats (it
-// checks the buffer only afterwards), which on a small robot computer means swapping or the OOM killer
-// instead of an error message.
+// LaserScans and TF messages read from a bag with their size checked before ROS deserializes them: a
+// corrupted array length in a bag record makes the generated deserializer resize a vector to billions of
+// elements (it checks the buffer only afterwards), which on a small robot computer means swapping or the
+// OOM killer instead of an error message.
 #pragma once
 
 #include <rosbag/message_instance.h>
