@@ -55,6 +55,8 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(m.weak_score, dm.weak_score);
   EXPECT_EQ(m.weak_matched_fraction, dm.weak_matched_fraction);
   EXPECT_EQ(m.weak_inflation, dm.weak_inflation);
+  EXPECT_EQ(m.rescue_margin, dm.rescue_margin);
+  EXPECT_EQ(m.rescue_window_theta, dm.rescue_window_theta);
   EXPECT_EQ(p.min_range, 0.0);
   EXPECT_EQ(p.max_range, 0.0);
   EXPECT_LT(p.angle_min, -M_PI);

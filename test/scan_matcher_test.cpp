@@ -86,6 +86,48 @@ TEST(ScanMatcher, DifferentialEvolutionEscapesPoorPriorsThatNewtonAloneDoesNot) 
   RecordProperty("newton_only_failures", newton_failures);
 }
 
+// A turn starting between two scans: the constant-velocity prior is 25–40° off, beyond DE's ±15° window.
+// The first search ends weak and wrong; the retry over ±45° (rescue_margin > 0) recovers the motion.
+TEST(ScanMatcher, WeakMatchIsRetriedOverAWiderWindow) {
+  const FloorPlan room = test::furnishedRoom();
+  ScanSimulator sim(room, ScanSimulatorConfig(), 9);
+  const Pose2D reference_pose(3.0, 2.5, 0.2);
+  ScanMatcherConfig with_retry;
+  with_retry.rescue_margin = 0.05;
+  ScanMatcherConfig without_retry = with_retry;
+  without_retry.rescue_margin = 0.0;
+  ScanMatcher a(with_retry), b(without_retry);
+  const auto ref = scanAt(sim, reference_pose);
+  a.setReference(ref);
+  b.setReference(ref);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> ang(25.0, 40.0), off(-0.1, 0.1);
+  int retry_failures = 0, plain_failures = 0, plain_weak_when_wrong = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const Pose2D motion(off(rng), off(rng), (trial & 1 ? 1 : -1) * ang(rng) * M_PI / 180.0);
+    const PreprocessedScan scan = preprocessedAt(sim, reference_pose * motion);
+    const auto pts = resampleScan(scan, ResamplingMethod::kSaliency, 100, SaliencyConfig(), trial);
+    std::mt19937_64 ra_rng(trial), rb_rng(trial);
+    const MatchResult ra = a.match(pts, scan.points, Pose2D(), ra_rng);
+    const MatchResult rb = b.match(pts, scan.points, Pose2D(), rb_rng);
+    auto wrong = [&](const MatchResult& r) {
+      return std::hypot(r.pose.x - motion.x, r.pose.y - motion.y) > 0.01 ||
+             std::abs(normalizeAngle(r.pose.theta - motion.theta)) > 0.2 * M_PI / 180.0;
+    };
+    if (wrong(ra)) ++retry_failures;
+    if (wrong(rb)) {
+      ++plain_failures;
+      if (rb.weak) ++plain_weak_when_wrong;
+    }
+    // The retry consumed nothing of the caller's generator.
+    EXPECT_EQ(ra_rng(), rb_rng()) << "trial " << trial;
+  }
+  EXPECT_EQ(retry_failures, 0);
+  EXPECT_GT(plain_failures, 0);
+  EXPECT_EQ(plain_weak_when_wrong, plain_failures);  // the failures it must catch are flagged weak
+  RecordProperty("failures_without_retry", plain_failures);
+}
+
 TEST(ScanMatcher, CorridorIsFlaggedDegenerateWithLargeVarianceAlongIt) {
   // Two long parallel walls along x, nothing else within range: x is unobservable.
   const FloorPlan corridor = test::planFromBoxes(40.0, 3.0, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.9, 40.0, 3.0}});

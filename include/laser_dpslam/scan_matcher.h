@@ -52,6 +52,11 @@ struct ScanMatcherConfig {
   double weak_score = 0.25;             ///< score per point (0…1) below which the match is weak
   double weak_matched_fraction = 0.5;   ///< matched fraction below which the match is weak
   double weak_inflation = 10.0;         ///< covariance multiplier for a weak match
+  /// > 0: a weak match is retried from the prior itself and by DE over ±rescue_window_theta; a retry
+  /// replaces it only when its score per point is higher by more than this. 0 = no retry (the default: on
+  /// MIT CSAIL it removes the odometry's fast-turn failures, but the SLAM closes the big loop less often).
+  double rescue_margin = 0.0;
+  double rescue_window_theta = 0.79;    ///< rad, θ half-width of the retry's DE window (≈ 45°)
 };
 
 struct MatchResult {

@@ -85,6 +85,8 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   nonNegative(s, "weak_score", m.weak_score);
   nonNegative(s, "weak_matched_fraction", m.weak_matched_fraction);
   positive(s, "weak_inflation", m.weak_inflation);
+  nonNegative(s, "rescue_margin", m.rescue_margin);
+  positive(s, "rescue_window_theta", m.rescue_window_theta);
 }
 
 }  // namespace laser_dpslam

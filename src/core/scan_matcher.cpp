@@ -122,8 +122,8 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   r.pose = prior;
   if (!hasReference() || points.empty() || polish_points.empty()) return r;
 
-  Pose2D start = prior;
-  if (config_.use_de && !raster_.empty()) {
+  // DE over a window around the prior (algorithms.md §3), the prior seeded into the population.
+  auto deSearch = [&](const Eigen::Vector3d& w, std::mt19937_64& rng) {
     using DE = DifferentialEvolution<3>;
     DE::Config dc;
     dc.population = config_.de_population;
@@ -134,37 +134,48 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     dc.strategy = DE::Strategy::kRand1Bin;
     dc.spread_tolerance = Eigen::Vector3d(config_.de_spread_xy, config_.de_spread_xy, config_.de_spread_theta);
     dc.stall_generations = config_.de_stall_generations;
-    const Eigen::Vector3d w(config_.window_xy, config_.window_xy, config_.window_theta);
     const Eigen::Vector3d p0 = prior.vector();
     // θ is searched unwrapped around the prior; normalised when the pose is formed.
     auto cost = [&](const Eigen::Vector3d& x) { return raster_.cost(Pose2D(x.x(), x.y(), x.z()), points); };
     const DE de(dc);
     const DE::Result res = de.minimize(cost, p0 - w, p0 + w, {p0}, rng);
-    r.de_generations = res.generations;
-    r.de_evaluations = res.evaluations;
-    start = Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
-  }
-
-  Pose2D pose = start;
-  for (std::size_t level = 0; level < grids_.size(); ++level) {
-    if (grids_[level].empty()) continue;
-    pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, &prior, prior_sigma_xy);
-  }
-  NdtScore s = grids_.back().score(pose, polish_points, true);
-  if (config_.keep_prior_when_degenerate) {
-    // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
-    // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
-    // (LOAM-style solution remapping, Zhang et al. 2016).
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
-    et.computeDirect(Eigen::Matrix2d(0.5 * (s.hessian.topLeftCorner<2, 2>() + s.hessian.topLeftCorner<2, 2>().transpose())));
-    if (!(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12))) {
-      const Eigen::Vector2d v = et.eigenvectors().col(0);
-      const Eigen::Vector2d d(pose.x - prior.x, pose.y - prior.y);
-      const Eigen::Vector2d xy = Eigen::Vector2d(pose.x, pose.y) - v * v.dot(d);
-      Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
-      basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
-      pose = polish(polish_points, Pose2D(xy.x(), xy.y(), pose.theta), grids_.size() - 1, &r.newton_iterations, &basis);
-      s = grids_.back().score(pose, polish_points, true);
+    r.de_generations += res.generations;
+    r.de_evaluations += res.evaluations;
+    return Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
+  };
+  // Newton polish coarse to fine, then the exact score at the finest resolution.
+  auto polishAll = [&](Pose2D pose, NdtScore* s) {
+    for (std::size_t level = 0; level < grids_.size(); ++level) {
+      if (grids_[level].empty()) continue;
+      pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, &prior, prior_sigma_xy);
+    }
+    *s = grids_.back().score(pose, polish_points, true);
+    return pose;
+  };
+  const double n4 = 4.0 * static_cast<double>(polish_points.size());
+  const bool de = config_.use_de && !raster_.empty();
+  NdtScore s;
+  Pose2D pose = polishAll(de ? deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng) : prior, &s);
+  if (config_.rescue_margin > 0.0 &&
+      (-s.h / n4 < config_.weak_score || s.matched < config_.weak_matched_fraction * static_cast<double>(polish_points.size()))) {
+    // A weak match is often a wrong one (a fast turn starting: the constant-velocity prior is off and the
+    // search ends on a false optimum). Try the prior itself and a search over a wider window; take one only
+    // if it scores clearly better, so that the flat optima of corridors are not traded for one another.
+    std::vector<Pose2D> starts{prior};
+    if (de) {
+      // A copy of the generator: a retry leaves the caller's random stream, and so every later match, as
+      // it would be without it.
+      std::mt19937_64 retry_rng = rng;
+      retry_rng.discard(1);
+      starts.push_back(deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.rescue_window_theta), retry_rng));
+    }
+    for (const Pose2D& st : starts) {
+      NdtScore cs;
+      const Pose2D cand = polishAll(st, &cs);
+      if (-cs.h / n4 > -s.h / n4 + config_.rescue_margin) {
+        pose = cand;
+        s = cs;
+      }
     }
   }
   r.pose = pose;
