@@ -152,12 +152,15 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     *s = grids_.back().score(pose, polish_points, true);
     return pose;
   };
-  const double n4 = 4.0 * static_cast<double>(polish_points.size());
+  const double n = static_cast<double>(polish_points.size());
+  auto scorePerPoint = [&](const NdtScore& s) { return -s.h / (4.0 * n); };  // in [0, 1]
+  auto isWeak = [&](const NdtScore& s) {
+    return scorePerPoint(s) < config_.weak_score || s.matched / n < config_.weak_matched_fraction;
+  };
   const bool de = config_.use_de && !raster_.empty();
   NdtScore s;
   Pose2D pose = polishAll(de ? deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng) : prior, &s);
-  if (config_.rescue_margin > 0.0 &&
-      (-s.h / n4 < config_.weak_score || s.matched < config_.weak_matched_fraction * static_cast<double>(polish_points.size()))) {
+  if (config_.rescue_margin > 0.0 && isWeak(s)) {
     // A weak match is often a wrong one (a fast turn starting: the constant-velocity prior is off and the
     // search ends on a false optimum). Try the prior itself and a search over a wider window; take one only
     // if it scores clearly better, so that the flat optima of corridors are not traded for one another.
@@ -172,18 +175,34 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     for (const Pose2D& st : starts) {
       NdtScore cs;
       const Pose2D cand = polishAll(st, &cs);
-      if (-cs.h / n4 > -s.h / n4 + config_.rescue_margin) {
+      if (scorePerPoint(cs) > scorePerPoint(s) + config_.rescue_margin) {
         pose = cand;
         s = cs;
       }
     }
   }
+  if (config_.keep_prior_when_degenerate) {
+    // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
+    // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
+    // (LOAM-style solution remapping, Zhang et al. 2016).
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
+    et.computeDirect(Eigen::Matrix2d(0.5 * (s.hessian.topLeftCorner<2, 2>() + s.hessian.topLeftCorner<2, 2>().transpose())));
+    if (!(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12))) {
+      const Eigen::Vector2d v = et.eigenvectors().col(0);
+      const Eigen::Vector2d d(pose.x - prior.x, pose.y - prior.y);
+      const Eigen::Vector2d xy = Eigen::Vector2d(pose.x, pose.y) - v * v.dot(d);
+      Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
+      basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
+      pose = polish(polish_points, Pose2D(xy.x(), xy.y(), pose.theta), grids_.size() - 1, &r.newton_iterations, &basis);
+      s = grids_.back().score(pose, polish_points, true);
+    }
+  }
   r.pose = pose;
 
   r.hessian = s.hessian;
-  r.score_per_point = -s.h / (4.0 * static_cast<double>(polish_points.size()));
-  r.matched_fraction = static_cast<double>(s.matched) / static_cast<double>(polish_points.size());
-  r.weak = r.score_per_point < config_.weak_score || r.matched_fraction < config_.weak_matched_fraction;
+  r.score_per_point = scorePerPoint(s);
+  r.matched_fraction = static_cast<double>(s.matched) / n;
+  r.weak = isWeak(s);
   r.covariance = covarianceFrom(s.hessian, r);
   r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
   if (!r.valid) r.pose = prior;
