@@ -84,9 +84,13 @@ TEST(LaserOdometry, BadScansAreSkippedAndNeverCorruptThePose) {
     const OdometryUpdate u = odom.process(preprocessScan(s, ScanPreprocessorConfig()), LaserMount());
     EXPECT_TRUE(u.pose.vector().allFinite());
     EXPECT_TRUE(u.pose_covariance.allFinite());
-    if (i % 10 == 5) EXPECT_EQ(u.skip_reason, "too_few_points");
-    if (i % 10 == 7) EXPECT_EQ(u.skip_reason, "malformed_scan");
-    if (i % 10 != 5 && i % 10 != 7) EXPECT_TRUE(u.ok) << i;
+    if (i % 10 == 5) {
+      EXPECT_EQ(u.skip_reason, "too_few_points");
+    } else if (i % 10 == 7) {
+      EXPECT_EQ(u.skip_reason, "malformed_scan");
+    } else {
+      EXPECT_TRUE(u.ok) << i;
+    }
   }
   // Still on track after the bad scans.
   const Pose2D truth = between(run.truth.front().pose, run.truth[59].pose);
@@ -123,4 +127,37 @@ TEST(LaserOdometry, MountedLaserGivesTheBasePose) {
   EXPECT_NEAR(odom.pose().x, expected.x, 0.03);
   EXPECT_NEAR(odom.pose().y, expected.y, 0.03);
   EXPECT_NEAR(odom.pose().theta, expected.theta, 0.01);
+}
+
+// The loop building's west corridor (plans/loop_building) as the loop drives it: from rest at its north end
+// to its south end (17.1 m). Between the niche and the south wall only weak structure constrains the pose
+// along it; taking the last motion as the prior's velocity lets the matches' small biases add up into a lag of
+// about 1 m (maps too short, the issue-4 failure). Smoothing the velocity (velocity_gain) at least halves it.
+// Measured with seeds 1-4 (final error, m): gain 1: 1.29, 0.97, 1.22, 0.79; gain 0.3: 0.45, 0.21, 0.42, 0.44.
+// Not fixed by it: starting from rest 2 m further south (the north wall 3.3 m away) stalls for seconds with
+// any gain.
+TEST(LaserOdometry, SmoothedVelocityShrinksTheCorridorLag) {
+  const FloorPlan plan = FloorPlan::load("plans/loop_building.yaml");
+  const std::vector<TimedPose> truth = samplePath({{1.95, 19.05}, {1.95, 1.95}}, 10.0, PathConfig());
+  auto finalError = [&](double gain, std::uint64_t seed) {
+    ScanSimulator sim(plan, ScanSimulatorConfig(), seed);
+    LaserOdometryConfig c;
+    c.velocity_gain = gain;
+    LaserOdometry odom(c);
+    for (const auto& tp : truth) {
+      odom.process(preprocessScan(sim.simulate(tp.pose, 100.0 + tp.stamp), ScanPreprocessorConfig()), LaserMount());
+    }
+    const Pose2D end = between(truth.front().pose, truth.back().pose);
+    return std::hypot(odom.pose().x - end.x, odom.pose().y - end.y);
+  };
+  double smoothed = 0.0, last_motion = 0.0;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const double s = finalError(LaserOdometryConfig().velocity_gain, seed), l = finalError(1.0, seed);
+    EXPECT_LT(s, l) << "seed " << seed;
+    smoothed += s;
+    last_motion += l;
+  }
+  EXPECT_LT(smoothed, 0.5 * last_motion);
+  RecordProperty("smoothed_mean_mm", static_cast<int>(1000.0 * smoothed / 3.0));
+  RecordProperty("last_motion_mean_mm", static_cast<int>(1000.0 * last_motion / 3.0));
 }

@@ -24,6 +24,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.local_map_keyframes, d.local_map_keyframes);
   EXPECT_EQ(o.keyframe_overlap_drop, d.keyframe_overlap_drop);
   EXPECT_EQ(o.prior_acceleration, d.prior_acceleration);
+  EXPECT_EQ(o.velocity_gain, d.velocity_gain);
   EXPECT_EQ(o.map_voxel, d.map_voxel);
   EXPECT_EQ(o.min_points, d.min_points);
   EXPECT_EQ(o.max_prior_gap, d.max_prior_gap);

@@ -31,6 +31,9 @@ struct LaserOdometryConfig {
   /// σ = ½·a·dt² (the displacement an unmodelled acceleration a causes over the scan interval dt), see
   /// ScanMatcherConfig::prior_sigma_xy. 0 = off.
   double prior_acceleration = 2.0;
+  /// (0, 1]: weight of the newest scan-to-scan translation velocity in the constant-velocity prior
+  /// (exponential smoothing per scan; 1 = the last motion only). 0.3 from scripts/benchmark_loop.sh and CSAIL.
+  double velocity_gain = 0.3;
   /// A new keyframe is also taken when the matched fraction fell this much below the first match after the
   /// last keyframe: new structure came into view that the local map lacks (0 = off). Without it a robot whose
   /// estimate stalls in a corridor never takes the keyframe that would show it the wall ahead.

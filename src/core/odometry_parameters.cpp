@@ -41,6 +41,8 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   atLeast(s, "local_map_keyframes", o.local_map_keyframes, 1);
   nonNegative(s, "keyframe_overlap_drop", o.keyframe_overlap_drop);
   nonNegative(s, "prior_acceleration", o.prior_acceleration);
+  positive(s, "velocity_gain", o.velocity_gain);
+  require(o.velocity_gain <= 1.0, "velocity_gain", o.velocity_gain, "must be <= 1");
   nonNegative(s, "map_voxel", o.map_voxel);
   atLeast(s, "min_points", o.min_points, 3);
   positive(s, "max_prior_gap", o.max_prior_gap);
