@@ -133,7 +133,7 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
   if (dt > 0.0 && dt <= config_.max_prior_gap) {
     // Translation: exponential smoothing (velocity_gain). Taking the last motion as the velocity feeds any
     // small per-match bias along a corridor back into the prior, where it adds up twice (a lag growing with
-    // the square of the scans: maps come out too short); the smoothing divides that feedback by 1/gain.
+    // the square of the scans: maps come out too short); the smoothing scales that feedback by the gain.
     // Rotation: the last motion (turns start and stop fast; the heading is well constrained anyway).
     const Eigen::Vector3d measured = Eigen::Vector3d(u.delta.x, u.delta.y, u.delta.theta) / dt;
     const double g = config_.velocity_gain;
