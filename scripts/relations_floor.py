@@ -15,6 +15,7 @@ Prints one JSON object (metres, degrees; mean and median of |translation| and me
 import argparse
 import json
 import math
+import os
 import sys
 
 import numpy as np
@@ -101,12 +102,15 @@ def read_scans(bag_path, topic):
     return scans
 
 
-def trajectory_motion(tum, t1, t2):
-    """Motion from t1 to t2 of a TUM trajectory, linearly interpolated (yaw on the shortest arc)."""
-    t = tum[:, 0]
-    yaw = np.unwrap(2.0 * np.arctan2(tum[:, 6], tum[:, 7]))
-    p = [np.array([np.interp(s, t, tum[:, 1]), np.interp(s, t, tum[:, 2]), np.interp(s, t, yaw)]) for s in (t1, t2)]
-    return vec(np.linalg.inv(se2(p[0])) @ se2(p[1]))
+def evaluate_relations_tool():
+    """tools/evaluate_relations as a module: its trajectory reader, interpolation and relation error."""
+    import importlib.machinery
+    import importlib.util
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'tools', 'evaluate_relations')
+    loader = importlib.machinery.SourceFileLoader('evaluate_relations', path)
+    module = importlib.util.module_from_spec(importlib.util.spec_from_loader('evaluate_relations', loader))
+    loader.exec_module(module)
+    return module
 
 
 def summary(errors):
@@ -126,7 +130,11 @@ def main(argv=None):
     scans = read_scans(a.bag, a.topic)
     stamps = np.array(sorted(scans))
     rel = np.loadtxt(a.relations, ndmin=2)
-    tum = np.loadtxt(a.trajectory, ndmin=2) if a.trajectory else None
+    traj = None
+    if a.trajectory:
+        er = evaluate_relations_tool()
+        rows, lines = er.read_table(a.trajectory, 8, 'TUM trajectory')
+        traj = er.Trajectory(rows, lines, a.trajectory)
 
     def scan_at(t):
         i = int(np.abs(stamps - t).argmin())
@@ -148,11 +156,14 @@ def main(argv=None):
         for key, est, ref in (("fwd", fwd, truth), ("rev", rev, truth), ("p2p", p2p, truth),
                               ("fwd_vs_rev", fwd, rev), ("fwd_vs_p2p", fwd, p2p)):
             out[key].append(error(est, ref))
-        if tum is not None:
-            motion = trajectory_motion(tum, t1, t2)
+        if traj is not None:
+            # The estimate's motion against delta* and against the matchers' mean motion, as evaluate_relations
+            # scores it (same interpolation and error).
             mean = np.mean([fwd, rev, p2p], axis=0)
-            out["estimate"].append(error(motion, truth))
-            out["estimate_vs_matchers"].append(error(motion, mean))
+            pair = np.array([[t1, t2, dx, dy, 0.0, 0.0, 0.0, yaw], [t1, t2, mean[0], mean[1], 0.0, 0.0, 0.0, mean[2]]])
+            trans, rot = er.relation_errors(traj, pair)
+            out["estimate"].append((trans[0], rot[0]))
+            out["estimate_vs_matchers"].append((trans[1], rot[1]))
     if not out["fwd"]:
         print("no relation has both its stamps in %s" % a.bag, file=sys.stderr)
         return 1

@@ -85,15 +85,21 @@ class FloorOnABag(unittest.TestCase):
                 d = rf.vec(np.linalg.inv(rf.se2(poses[k])) @ rf.se2(poses[k + 1]))
                 f.write('%.6f %.6f %.6f %.6f 0 0 0 %.6f\n' % (100.0 + k, 101.0 + k, d[0] + 0.03, d[1], d[2]))
             f.write('100.0 150.0 0 0 0 0 0 0\n')  # no scan at 150 s
+        tum_path = os.path.join(self.dir, 't.tum')  # the true poses as the estimate
+        with open(tum_path, 'w') as f:
+            for k, p in enumerate(poses):
+                f.write('%.6f %.9f %.9f 0 0 0 %.12f %.12f\n' % (100.0 + k, p[0], p[1], math.sin(p[2] / 2), math.cos(p[2] / 2)))
         out = io.StringIO()
         with redirect_stdout(out):
-            self.assertEqual(rf.main(['--bag', bag_path, '--relations', rel_path]), 0)
+            self.assertEqual(rf.main(['--bag', bag_path, '--relations', rel_path, '--trajectory', tum_path]), 0)
         res = json.loads(out.getvalue())
         self.assertEqual(res['relations_used'], 3)
         self.assertEqual(res['relations_without_scans'], 1)
         for k in ('fwd', 'rev', 'p2p'):
             self.assertAlmostEqual(res[k]['trans_abs_mean'], 0.03, delta=0.005, msg=k)
         self.assertLess(res['fwd_vs_p2p']['trans_abs_mean'], 0.005)
+        self.assertAlmostEqual(res['estimate']['trans_abs_mean'], 0.03, delta=1e-4)  # the relations' offset
+        self.assertLess(res['estimate_vs_matchers']['trans_abs_mean'], 0.005)
 
 
 if __name__ == '__main__':
