@@ -160,19 +160,17 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   const bool de = config_.use_de && !raster_.empty();
   NdtScore s;
   Pose2D pose = polishAll(de ? deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng) : prior, &s);
-  if (config_.rescue_margin > 0.0 && isWeak(s)) {
+  if (config_.rescue_margin > 0.0 && de && isWeak(s)) {
     // A weak match is often a wrong one (a fast turn starting: the constant-velocity prior is off and the
     // search ends on a false optimum). Try the prior itself and a search over a wider window; take one only
     // if it scores clearly better, so that the flat optima of corridors are not traded for one another.
-    std::vector<Pose2D> starts{prior};
-    if (de) {
-      // A copy of the generator: a retry leaves the caller's random stream, and so every later match, as
-      // it would be without it.
-      std::mt19937_64 retry_rng = rng;
-      retry_rng.discard(1);
-      starts.push_back(deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.rescue_window_theta), retry_rng));
-    }
-    for (const Pose2D& st : starts) {
+    // (Without DE the match already started from the prior: nothing to retry.)
+    // A copy of the generator: a retry leaves the caller's random stream, and so every later match, as it
+    // would be without it.
+    std::mt19937_64 retry_rng = rng;
+    retry_rng.discard(1);
+    const Pose2D wide = deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.rescue_window_theta), retry_rng);
+    for (const Pose2D& st : {prior, wide}) {
       NdtScore cs;
       const Pose2D cand = polishAll(st, &cs);
       if (scorePerPoint(cs) > scorePerPoint(s) + config_.rescue_margin) {
