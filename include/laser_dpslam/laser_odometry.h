@@ -26,7 +26,7 @@ struct LaserOdometryConfig {
   ScanMatcherConfig matcher;
   double keyframe_distance = 0.25;   ///< m moved since the last keyframe before a new one is taken
   double keyframe_angle = 0.17;      ///< rad turned since the last keyframe before a new one is taken
-  int local_map_keyframes = 5;       ///< keyframes in the local map
+  int local_map_keyframes = 10;      ///< keyframes in the local map (10 × 0.25 m: scripts/benchmark_loop.sh, CSAIL)
   /// m/s²; > 0: the constant-velocity prior enters the Newton polish as a Gaussian on the translation with
   /// σ = ½·a·dt² (the displacement an unmodelled acceleration a causes over the scan interval dt), see
   /// ScanMatcherConfig::prior_sigma_xy. 0 = off.
