@@ -51,6 +51,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(m.min_sigma_theta, dm.min_sigma_theta);
   EXPECT_EQ(m.degeneracy_ratio, dm.degeneracy_ratio);
   EXPECT_EQ(m.degenerate_sigma, dm.degenerate_sigma);
+  EXPECT_EQ(m.degenerate_sigma_with_prior, dm.degenerate_sigma_with_prior);
   EXPECT_EQ(m.keep_prior_when_degenerate, dm.keep_prior_when_degenerate);
   EXPECT_EQ(m.prior_sigma_xy, dm.prior_sigma_xy);
   EXPECT_EQ(m.weak_score, dm.weak_score);

@@ -140,6 +140,16 @@ TEST(ScanMatcher, CorridorIsFlaggedDegenerateWithLargeVarianceAlongIt) {
   EXPECT_TRUE(r.degenerate);
   EXPECT_GT(r.covariance(0, 0), 100.0 * r.covariance(1, 1));  // along the corridor ≫ across it
   EXPECT_LT(std::abs(r.pose.y), 0.01);                        // across is still well determined
+  EXPECT_GT(std::sqrt(r.covariance(0, 0)), 0.3);  // degenerate_sigma: nothing holds that direction
+
+  // With the soft motion prior in the match, the prior holds the corridor direction: still flagged, but the
+  // σ along it is degenerate_sigma_with_prior's (2 cm), not 0.3 m.
+  const std::vector<Eigen::Vector2d> moved = scanAt(sim, Pose2D(20.1, 1.5, 0.0));
+  const MatchResult rp = m.match(moved, moved, Pose2D(0.1, 0.0, 0.0), rng, 0.01);
+  ASSERT_TRUE(rp.valid);
+  EXPECT_TRUE(rp.degenerate);
+  EXPECT_LT(std::sqrt(rp.covariance(0, 0)), 0.1);
+  EXPECT_GT(std::sqrt(rp.covariance(0, 0)), 0.02);
 
   // A well-constrained room is not flagged and gets centimetre-level standard deviations.
   const FloorPlan room = test::furnishedRoom();

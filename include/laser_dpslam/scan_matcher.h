@@ -44,6 +44,10 @@ struct ScanMatcherConfig {
   double min_sigma_theta = 0.002;       ///< rad, standard deviation floor
   double degeneracy_ratio = 0.02;       ///< eigenvalue of H's translation block below this × its largest: degenerate
   double degenerate_sigma = 0.3;        ///< m, σ added along a degenerate translation direction
+  /// m, the same when the soft motion prior took part in the match (prior_sigma_xy > 0): the prior then
+  /// holds that direction to about its own σ per scan, and a σ of 0.3 m per scan let the DP-SLAM's
+  /// particles random-walk along corridors (README "Benchmarks").
+  double degenerate_sigma_with_prior = 0.02;
   bool keep_prior_when_degenerate = false;  ///< along a degenerate direction keep the motion prior exactly (superseded by the soft prior of LaserOdometryConfig::prior_acceleration)
   /// m; > 0: the Newton polish minimises h + α/2·|t − t_prior|²/σ² (a Gaussian motion prior of this σ on the
   /// translation, in h's units through Σ = α·H⁻¹): where the scan constrains the pose the data wins, along a
@@ -103,7 +107,7 @@ class ScanMatcher {
   const NdtGrid& grid(std::size_t level) const { return grids_.at(level); }
 
  private:
-  Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, MatchResult& result) const;
+  Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& result) const;
 
   ScanMatcherConfig config_;
   std::vector<NdtGrid> grids_;

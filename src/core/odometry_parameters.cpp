@@ -82,6 +82,7 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   positive(s, "min_sigma_theta", m.min_sigma_theta);
   positive(s, "degeneracy_ratio", m.degeneracy_ratio);
   positive(s, "degenerate_sigma", m.degenerate_sigma);
+  positive(s, "degenerate_sigma_with_prior", m.degenerate_sigma_with_prior);
   s.get("keep_prior_when_degenerate", m.keep_prior_when_degenerate);
   nonNegative(s, "prior_sigma_xy", m.prior_sigma_xy);
   nonNegative(s, "weak_score", m.weak_score);

@@ -89,7 +89,7 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
   return pose;
 }
 
-Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, MatchResult& r) const {
+Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& r) const {
   // Σ = α·H⁻¹ + Σ_min (algorithms.md §2 [P]): h is not a normalised likelihood, so H⁻¹ alone is
   // over-confident. H's eigenvalues are floored so that a singular H still gives a finite (large) Σ.
   const Eigen::Matrix3d Hs = 0.5 * (hessian + hessian.transpose());
@@ -106,7 +106,8 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, Matc
   r.degenerate = !(et.eigenvalues()(0) > config_.degeneracy_ratio * tmax);
   if (r.degenerate) {
     const Eigen::Vector2d v = et.eigenvectors().col(0);
-    cov.topLeftCorner<2, 2>() += config_.degenerate_sigma * config_.degenerate_sigma * v * v.transpose();
+    const double sigma = with_prior ? config_.degenerate_sigma_with_prior : config_.degenerate_sigma;
+    cov.topLeftCorner<2, 2>() += sigma * sigma * v * v.transpose();
   }
   cov(0, 0) += config_.min_sigma_xy * config_.min_sigma_xy;
   cov(1, 1) += config_.min_sigma_xy * config_.min_sigma_xy;
@@ -201,7 +202,8 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   r.score_per_point = scorePerPoint(s);
   r.matched_fraction = static_cast<double>(s.matched) / n;
   r.weak = isWeak(s);
-  r.covariance = covarianceFrom(s.hessian, r);
+  const bool with_prior = (prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy) > 0.0;
+  r.covariance = covarianceFrom(s.hessian, with_prior, r);
   r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
   if (!r.valid) r.pose = prior;
   return r;
