@@ -108,6 +108,10 @@ class ScanMatcher {
 
  private:
   Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& result) const;
+  /// The σ of the motion prior in effect: this scan's when given (>= 0), the config's otherwise.
+  double priorSigma(double prior_sigma_xy) const {
+    return prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy;
+  }
 
   ScanMatcherConfig config_;
   std::vector<NdtGrid> grids_;

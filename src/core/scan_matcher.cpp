@@ -32,7 +32,7 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
                            const Pose2D* prior, double prior_sigma_xy) const {
   const NdtGrid& grid = grids_.at(level);
   // The motion prior as a quadratic term in h's units (Σ = α·H⁻¹ ⇒ information α⁻¹·H), see prior_sigma_xy.
-  const double sigma = prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy;
+  const double sigma = priorSigma(prior_sigma_xy);
   const double w = prior && sigma > 0.0 ? config_.covariance_scale / (sigma * sigma) : 0.0;
   auto score = [&](const Pose2D& p) {
     NdtScore r = grid.score(p, points, true);
@@ -202,8 +202,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   r.score_per_point = scorePerPoint(s);
   r.matched_fraction = static_cast<double>(s.matched) / n;
   r.weak = isWeak(s);
-  const bool with_prior = (prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy) > 0.0;
-  r.covariance = covarianceFrom(s.hessian, with_prior, r);
+  r.covariance = covarianceFrom(s.hessian, priorSigma(prior_sigma_xy) > 0.0, r);
   r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
   if (!r.valid) r.pose = prior;
   return r;
