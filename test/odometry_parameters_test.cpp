@@ -25,6 +25,8 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.keyframe_overlap_drop, d.keyframe_overlap_drop);
   EXPECT_EQ(o.prior_acceleration, d.prior_acceleration);
   EXPECT_EQ(o.velocity_gain, d.velocity_gain);
+  EXPECT_EQ(o.match_range_margin, d.match_range_margin);
+  EXPECT_EQ(o.degenerate_velocity_gain, d.degenerate_velocity_gain);
   EXPECT_EQ(o.map_voxel, d.map_voxel);
   EXPECT_EQ(o.min_points, d.min_points);
   EXPECT_EQ(o.max_prior_gap, d.max_prior_gap);
@@ -86,6 +88,8 @@ TEST(OdometryParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("resampling: random").find("saliency"), std::string::npos);
   EXPECT_NE(message("ndt_cell_sizes: [1.0, -0.5]").find("ndt_cell_sizes"), std::string::npos);
   EXPECT_NE(message("de_CR: 1.5").find("de_CR"), std::string::npos);
+  EXPECT_NE(message("match_range_margin: -0.5").find("match_range_margin"), std::string::npos);
+  EXPECT_NE(message("degenerate_velocity_gain: 2").find("degenerate_velocity_gain"), std::string::npos);
   EXPECT_NE(message("angle_min: 1.0\nangle_max: 0.5").find("angle_min"), std::string::npos);
 }
 

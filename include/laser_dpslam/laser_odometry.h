@@ -38,6 +38,17 @@ struct LaserOdometryConfig {
   /// last keyframe: new structure came into view that the local map lacks (0 = off). Without it a robot whose
   /// estimate stalls in a corridor never takes the keyframe that would show it the wall ahead.
   double keyframe_overlap_drop = 0.1;
+  /// m; > 0: scan points with a range above (range_max − this) are left out of the match (they still
+  /// join keyframes). The local map was seen from up to a keyframe spacing behind, so the current scan's
+  /// farthest points reach past the map's edge; where nothing else fixes the position along a corridor
+  /// they pull the match back towards the map. 0.5 helped on the simulated loop building (scripts/
+  /// benchmark_loop.sh) but doubled the share of degenerate matches on the real 8 m log loop5 (those far points
+  /// are often a corridor's end), so it is opt-in. 0 = off.
+  double match_range_margin = 0.0;
+  /// [0, 1]: velocity_gain along the unconstrained direction of a degenerate match (corridor), where the
+  /// match's motion is mostly the prior plus the score's ripple; < velocity_gain averages that ripple
+  /// over more scans. Negative = velocity_gain.
+  double degenerate_velocity_gain = -1.0;
   double map_voxel = 0.05;           ///< m, voxel size of the local map's points
   int min_points = 20;               ///< fewer valid points: the scan is skipped
   double max_prior_gap = 1.0;        ///< s; a longer gap between scans gives a zero-velocity prior

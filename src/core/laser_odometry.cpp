@@ -1,5 +1,7 @@
 #include "laser_dpslam/laser_odometry.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 
 #include "laser_dpslam/voxel_filter.h"
@@ -34,6 +36,29 @@ void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points)
 }
 
 namespace {
+// The scan without its points beyond (range_max − margin), into *out; false (out untouched) when nothing
+// would be left out or fewer than min_points would remain (open space: match everything).
+bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_points, PreprocessedScan* out) {
+  if (margin <= 0.0 || scan.range_max <= margin) return false;
+  const double limit = scan.range_max - margin;
+  std::size_t keep = 0;
+  for (double r : scan.ranges) keep += r <= limit ? 1 : 0;
+  if (keep == scan.ranges.size() || static_cast<int>(keep) < min_points) return false;
+  *out = scan;
+  out->points.clear();
+  out->beams.clear();
+  out->ranges.clear();
+  out->angles.clear();
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    if (scan.ranges[i] > limit) continue;
+    out->points.push_back(scan.points[i]);
+    out->beams.push_back(scan.beams[i]);
+    out->ranges.push_back(scan.ranges[i]);
+    out->angles.push_back(scan.angles[i]);
+  }
+  return true;
+}
+
 // Jacobians of a ⊕ b with respect to a and b.
 void composeJacobians(const Pose2D& a, const Pose2D& b, Eigen::Matrix3d* Ja, Eigen::Matrix3d* Jb) {
   const double c = std::cos(a.theta), s = std::sin(a.theta);
@@ -97,14 +122,17 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
   if (dt <= config_.max_prior_gap) prior_delta = Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
   const Pose2D prior = pose_ * prior_delta;
 
+  PreprocessedScan trimmed;
+  const bool trim = trimToMatchRange(scan, config_.match_range_margin, config_.min_points, &trimmed);
+  const PreprocessedScan& near = trim ? trimmed : scan;
   const std::vector<Eigen::Vector2d> match_points = mount.apply(
-      resampleScan(scan, config_.resampling, static_cast<std::size_t>(std::max(1, config_.resampling_budget)),
+      resampleScan(near, config_.resampling, static_cast<std::size_t>(std::max(1, config_.resampling_budget)),
                    config_.saliency, config_.seed + scan_count_));
   const std::vector<Eigen::Vector2d> polish_points =
-      config_.polish_budget > 0 && static_cast<int>(scan.points.size()) > config_.polish_budget
-          ? mount.apply(resampleScan(scan, ResamplingMethod::kUniform, static_cast<std::size_t>(config_.polish_budget),
+      config_.polish_budget > 0 && static_cast<int>(near.points.size()) > config_.polish_budget
+          ? mount.apply(resampleScan(near, ResamplingMethod::kUniform, static_cast<std::size_t>(config_.polish_budget),
                                      config_.saliency, 0))
-          : base_points;
+          : (trim ? mount.apply(near.points) : base_points);
   ++scan_count_;
   u.points_used = static_cast<int>(polish_points.size());
   const double prior_sigma = config_.prior_acceleration > 0.0 && dt > 0.0 && dt <= config_.max_prior_gap
@@ -137,7 +165,16 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
     // Rotation: the last motion (turns start and stop fast; the heading is well constrained anyway).
     const Eigen::Vector3d measured = Eigen::Vector3d(u.delta.x, u.delta.y, u.delta.theta) / dt;
     const double g = config_.velocity_gain;
-    velocity_.head<2>() = (1.0 - g) * velocity_.head<2>() + g * measured.head<2>();
+    const Eigen::Vector2d before = velocity_.head<2>();
+    velocity_.head<2>() = (1.0 - g) * before + g * measured.head<2>();
+    const double gw = config_.degenerate_velocity_gain;
+    if (gw >= 0.0 && u.match.degenerate) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+      es.computeDirect(Eigen::Matrix2d(0.5 * (u.match.hessian.topLeftCorner<2, 2>() +
+                                              u.match.hessian.topLeftCorner<2, 2>().transpose())));
+      const Eigen::Vector2d weak = previous.rotation().transpose() * es.eigenvectors().col(0);
+      velocity_.head<2>() += weak * ((gw - g) * weak.dot(measured.head<2>() - before));
+    }
     velocity_.z() = measured.z();
   } else {
     velocity_.setZero();

@@ -43,6 +43,10 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   nonNegative(s, "prior_acceleration", o.prior_acceleration);
   positive(s, "velocity_gain", o.velocity_gain);
   require(o.velocity_gain <= 1.0, "velocity_gain", o.velocity_gain, "must be <= 1");
+  nonNegative(s, "match_range_margin", o.match_range_margin);
+  if (s.get("degenerate_velocity_gain", o.degenerate_velocity_gain)) {
+    require(o.degenerate_velocity_gain <= 1.0, "degenerate_velocity_gain", o.degenerate_velocity_gain, "must be <= 1");
+  }
   nonNegative(s, "map_voxel", o.map_voxel);
   atLeast(s, "min_points", o.min_points, 3);
   positive(s, "max_prior_gap", o.max_prior_gap);
