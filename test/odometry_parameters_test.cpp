@@ -27,6 +27,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.velocity_gain, d.velocity_gain);
   EXPECT_EQ(o.match_range_margin, d.match_range_margin);
   EXPECT_EQ(o.degenerate_velocity_gain, d.degenerate_velocity_gain);
+  EXPECT_EQ(o.degenerate_velocity_max_range, d.degenerate_velocity_max_range);
   EXPECT_EQ(o.map_voxel, d.map_voxel);
   EXPECT_EQ(o.min_points, d.min_points);
   EXPECT_EQ(o.max_prior_gap, d.max_prior_gap);

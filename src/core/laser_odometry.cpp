@@ -168,7 +168,9 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
     const Eigen::Vector2d before = velocity_.head<2>();
     velocity_.head<2>() = (1.0 - g) * before + g * measured.head<2>();
     const double gw = config_.degenerate_velocity_gain;
-    if (gw >= 0.0 && u.match.degenerate) {
+    const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
+                             scan.range_max <= config_.degenerate_velocity_max_range;
+    if (gw >= 0.0 && short_range && u.match.degenerate) {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
       es.computeDirect(Eigen::Matrix2d(0.5 * (u.match.hessian.topLeftCorner<2, 2>() +
                                               u.match.hessian.topLeftCorner<2, 2>().transpose())));

@@ -47,6 +47,7 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   if (s.get("degenerate_velocity_gain", o.degenerate_velocity_gain)) {
     require(o.degenerate_velocity_gain <= 1.0, "degenerate_velocity_gain", o.degenerate_velocity_gain, "must be <= 1");
   }
+  nonNegative(s, "degenerate_velocity_max_range", o.degenerate_velocity_max_range);
   nonNegative(s, "map_voxel", o.map_voxel);
   atLeast(s, "min_points", o.min_points, 3);
   positive(s, "max_prior_gap", o.max_prior_gap);
