@@ -71,6 +71,7 @@ struct MatchResult {
   double score_per_point = 0.0;   ///< −h / (4·points) in [0, 1]: 1 = every point on a cell mean
   double matched_fraction = 0.0;  ///< points within 3σ of a cell
   bool degenerate = false;        ///< a direction is unconstrained (corridor, single wall)
+  Eigen::Vector2d weak_direction = Eigen::Vector2d::Zero();  ///< unit, reference frame: that direction (when degenerate)
   bool weak = false;              ///< low score or low overlap
   int de_generations = 0;
   int de_evaluations = 0;

@@ -1,7 +1,5 @@
 #include "laser_dpslam/laser_odometry.h"
 
-#include <Eigen/Eigenvalues>
-
 #include <cmath>
 
 #include "laser_dpslam/voxel_filter.h"
@@ -171,10 +169,7 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
     const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
                              scan.range_max <= config_.degenerate_velocity_max_range;
     if (gw >= 0.0 && short_range && u.match.degenerate) {
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
-      es.computeDirect(Eigen::Matrix2d(0.5 * (u.match.hessian.topLeftCorner<2, 2>() +
-                                              u.match.hessian.topLeftCorner<2, 2>().transpose())));
-      const Eigen::Vector2d weak = previous.rotation().transpose() * es.eigenvectors().col(0);
+      const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
       velocity_.head<2>() += weak * ((gw - g) * weak.dot(measured.head<2>() - before));
     }
     velocity_.z() = measured.z();

@@ -106,6 +106,7 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool
   r.degenerate = !(et.eigenvalues()(0) > config_.degeneracy_ratio * tmax);
   if (r.degenerate) {
     const Eigen::Vector2d v = et.eigenvectors().col(0);
+    r.weak_direction = v;
     const double sigma = with_prior ? config_.degenerate_sigma_with_prior : config_.degenerate_sigma;
     cov.topLeftCorner<2, 2>() += sigma * sigma * v * v.transpose();
   }
