@@ -33,7 +33,8 @@ const SimRun& loopRun() {
     r.truth = samplePath(repeatLoop(loop, 2), 10.0, PathConfig());
     ScanSimulator sim(room, ScanSimulatorConfig(), 21);
     // The odometry that feeds these DP-SLAM tests is pinned (its defaults of 2026-11-29: a 5-keyframe
-    // local map, no turn retry, 0.3 m along corridors, no match_range_margin, no degenerate_velocity_gain), so that they test the filter on a fixed input. With
+    // local map, no turn retry, 0.3 m along corridors, no match_range_margin, no degenerate_velocity_gain),
+    // so that they test the filter on a fixed input. With
     // 10 keyframes and the retry this loop's SLAM max error over filter seeds 1-5 was
     // 0.127/0.111/0.084/0.072/0.092 m against 0.104/0.099/0.085/0.090/0.074 m (same end errors, 0.018 m
     // mean); the pipeline is measured by the benchmarks (README "Benchmarks").
