@@ -28,18 +28,27 @@ SimRun simulateLoop(std::uint64_t seed) {
   return run;
 }
 
-// Drives the loop building's west corridor (plans/loop_building) as the loop does, from rest at its north
-// end to its south end (17.1 m), and returns the odometry's final position error (m).
-double westCorridorFinalError(const LaserOdometryConfig& config, std::uint64_t seed) {
+// Drives `truth` through the loop building (plans/loop_building) and returns the odometry's final position
+// error (m); *max_still_error: the largest position error while the robot has not yet moved.
+double loopBuildingFinalError(const std::vector<TimedPose>& truth, const LaserOdometryConfig& config,
+                              std::uint64_t seed, double* max_still_error = nullptr) {
   static const FloorPlan plan = FloorPlan::load("plans/loop_building.yaml");
-  static const std::vector<TimedPose> truth = samplePath({{1.95, 19.05}, {1.95, 1.95}}, 10.0, PathConfig());
   ScanSimulator sim(plan, ScanSimulatorConfig(), seed);
   LaserOdometry odom(config);
   for (const auto& tp : truth) {
     odom.process(preprocessScan(sim.simulate(tp.pose, 100.0 + tp.stamp), ScanPreprocessorConfig()), LaserMount());
+    if (max_still_error && between(truth.front().pose, tp.pose).vector().norm() == 0.0) {
+      *max_still_error = std::max(*max_still_error, std::hypot(odom.pose().x, odom.pose().y));
+    }
   }
   const Pose2D end = between(truth.front().pose, truth.back().pose);
   return std::hypot(odom.pose().x - end.x, odom.pose().y - end.y);
+}
+
+// The loop building's west corridor as the loop drives it, from rest at its north end to its south end (17.1 m).
+double westCorridorFinalError(const LaserOdometryConfig& config, std::uint64_t seed) {
+  static const std::vector<TimedPose> truth = samplePath({{1.95, 19.05}, {1.95, 1.95}}, 10.0, PathConfig());
+  return loopBuildingFinalError(truth, config, seed);
 }
 
 }  // namespace
@@ -154,6 +163,7 @@ TEST(LaserOdometry, SmoothedVelocityShrinksTheCorridorLag) {
     LaserOdometryConfig c;
     c.velocity_gain = gain;
     c.degenerate_velocity_gain = -1.0;  // the same gain along the corridor (that one has its own test below)
+    c.prior_release_speed = 0.0;        // and no prior release (its own test below)
     return westCorridorFinalError(c, seed);
   };
   double smoothed = 0.0, last_motion = 0.0;
@@ -206,8 +216,10 @@ TEST(LaserOdometry, DegenerateVelocityGainShrinksTheCorridorStall) {
   LaserOdometryConfig margin, with_gain;
   margin.match_range_margin = 0.5;
   margin.degenerate_velocity_gain = -1.0;
+  margin.prior_release_speed = 0.0;  // measured before it (its own test below)
   with_gain.match_range_margin = 0.5;
   with_gain.degenerate_velocity_gain = 0.1;
+  with_gain.prior_release_speed = 0.0;
   double e_margin = 0.0, e_gain = 0.0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     const double a = westCorridorFinalError(margin, seed), b = westCorridorFinalError(with_gain, seed);
@@ -222,4 +234,32 @@ TEST(LaserOdometry, DegenerateVelocityGainShrinksTheCorridorStall) {
   EXPECT_EQ(westCorridorFinalError(gated, 1), westCorridorFinalError(margin, 1));
   RecordProperty("margin_only_mean_mm", static_cast<int>(1000.0 * e_margin / 3.0));
   RecordProperty("with_gain_mean_mm", static_cast<int>(1000.0 * e_gain / 3.0));
+}
+
+// The loop building's start: from rest in the south corridor (x = 15 m), 6 m east. Walls run along both sides
+// and only a pillar ahead shows motion along the corridor; the soft motion prior says "at rest" and the
+// smoothed velocity catches up slowly, so the estimate falls 0.6-1.2 m behind in the first 5 s and never
+// recovers it (scripts/benchmark_loop.sh, before prior_release_speed). Dropping the prior while the estimate
+// is slow and the scan fits clearly better without it keeps the start. Final error, seeds 1-3 (m): without
+// 2.071, 0.914, 0.658; with 0.063, 0.037, 0.060. While the robot stands still first (3 s) the release must add
+// no motion (the estimate creeps 3.5-4.4 cm along the corridor then, with or without it).
+TEST(LaserOdometry, PriorReleaseKeepsAStartFromRestInACorridor) {
+  PathConfig path;
+  path.start_pause = 3.0;
+  static const std::vector<TimedPose> truth = samplePath({{15.0, 1.95}, {21.0, 1.95}}, 10.0, path);
+  LaserOdometryConfig off;
+  off.prior_release_speed = 0.0;
+  double e_off = 0.0, e_on = 0.0;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    double still = 0.0, still_off = 0.0;
+    const double a = loopBuildingFinalError(truth, off, seed, &still_off), b = loopBuildingFinalError(truth, LaserOdometryConfig(), seed, &still);
+    EXPECT_LT(b, 0.3 * a) << "seed " << seed;
+    EXPECT_LE(still, still_off + 1e-3) << "seed " << seed;
+    e_off += a;
+    e_on += b;
+  }
+  EXPECT_GT(e_off / 3.0, 0.3);  // the case is still hard without it
+  EXPECT_LT(e_on / 3.0, 0.1);
+  RecordProperty("without_mean_mm", static_cast<int>(1000.0 * e_off / 3.0));
+  RecordProperty("with_mean_mm", static_cast<int>(1000.0 * e_on / 3.0));
 }

@@ -28,6 +28,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.match_range_margin, d.match_range_margin);
   EXPECT_EQ(o.degenerate_velocity_gain, d.degenerate_velocity_gain);
   EXPECT_EQ(o.degenerate_velocity_max_range, d.degenerate_velocity_max_range);
+  EXPECT_EQ(o.prior_release_speed, d.prior_release_speed);
   EXPECT_EQ(o.map_voxel, d.map_voxel);
   EXPECT_EQ(o.min_points, d.min_points);
   EXPECT_EQ(o.max_prior_gap, d.max_prior_gap);
@@ -62,6 +63,8 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(m.weak_inflation, dm.weak_inflation);
   EXPECT_EQ(m.rescue_margin, dm.rescue_margin);
   EXPECT_EQ(m.rescue_window_theta, dm.rescue_window_theta);
+  EXPECT_EQ(m.prior_release_margin, dm.prior_release_margin);
+  EXPECT_EQ(m.prior_release_sigmas, dm.prior_release_sigmas);
   EXPECT_EQ(p.min_range, 0.0);
   EXPECT_EQ(p.max_range, 0.0);
   EXPECT_LT(p.angle_min, -M_PI);
@@ -91,6 +94,7 @@ TEST(OdometryParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("de_CR: 1.5").find("de_CR"), std::string::npos);
   EXPECT_NE(message("match_range_margin: -0.5").find("match_range_margin"), std::string::npos);
   EXPECT_NE(message("degenerate_velocity_gain: 2").find("degenerate_velocity_gain"), std::string::npos);
+  EXPECT_NE(message("prior_release_speed: -0.1").find("prior_release_speed"), std::string::npos);
   EXPECT_NE(message("angle_min: 1.0\nangle_max: 0.5").find("angle_min"), std::string::npos);
 }
 

@@ -53,6 +53,11 @@ struct LaserOdometryConfig {
   /// A short-range laser sees little along a corridor and the ripple dominates (CSAIL cut to 5.6 m: SLAM
   /// error −39 %); a long-range one sees far structure and real speed changes (full-range CSAIL: worse).
   double degenerate_velocity_max_range = 10.0;
+  /// m/s; > 0: while the estimated speed is below this, a degenerate (corridor) match may drop the motion
+  /// prior when the scan fits clearly better without it (ScanMatcherConfig::prior_release_margin). Starting
+  /// from rest in a corridor, the prior says "at rest" and the smoothed velocity catches up slowly: the
+  /// loop building's start lost 0.6–1.2 m in 5 s (0.04–0.08 m with it; scripts/benchmark_loop.sh). 0 = off.
+  double prior_release_speed = 0.15;
   double map_voxel = 0.05;           ///< m, voxel size of the local map's points
   int min_points = 20;               ///< fewer valid points: the scan is skipped
   double max_prior_gap = 1.0;        ///< s; a longer gap between scans gives a zero-velocity prior

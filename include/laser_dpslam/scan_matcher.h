@@ -61,6 +61,12 @@ struct ScanMatcherConfig {
   /// odometry's turn failures (MIT CSAIL at 4.7 Hz, an in-place turn of the loop building); see the README.
   double rescue_margin = 0.05;
   double rescue_window_theta = 0.79;    ///< rad, θ half-width of the retry's DE window (≈ 45°)
+  /// Prior release (only where the caller allows it, see LaserOdometryConfig::prior_release_speed): a
+  /// degenerate match held by the soft motion prior is polished again without it; the result replaces it when
+  /// its score per point is higher by more than this and it lies more than prior_release_sigmas × the prior's
+  /// σ away along the weak direction (the prior, not the scan, was wrong: a robot starting to move).
+  double prior_release_margin = 0.004;
+  double prior_release_sigmas = 3.0;   ///< see prior_release_margin
 };
 
 struct MatchResult {
@@ -73,6 +79,7 @@ struct MatchResult {
   bool degenerate = false;        ///< a direction is unconstrained (corridor, single wall)
   Eigen::Vector2d weak_direction = Eigen::Vector2d::Zero();  ///< unit, reference frame: that direction (when degenerate)
   bool weak = false;              ///< low score or low overlap
+  bool prior_released = false;    ///< the motion prior was dropped (prior_release_margin)
   int de_generations = 0;
   int de_evaluations = 0;
   int newton_iterations = 0;
@@ -95,8 +102,10 @@ class ScanMatcher {
   /// the Newton polish, the covariance and the quality use `polish_points` (more points: the precision
   /// of the estimate grows with them, and Newton needs only a few evaluations).
   /// `prior_sigma_xy` < 0: the config's; otherwise this scan's σ of the motion prior (see the config).
+  /// `allow_prior_release`: a degenerate match may drop that prior (ScanMatcherConfig::prior_release_margin).
   MatchResult match(const std::vector<Eigen::Vector2d>& search_points, const std::vector<Eigen::Vector2d>& polish_points,
-                    const Pose2D& prior, std::mt19937_64& rng, double prior_sigma_xy = -1.0) const;
+                    const Pose2D& prior, std::mt19937_64& rng, double prior_sigma_xy = -1.0,
+                    bool allow_prior_release = false) const;
 
   /// Newton polish only, from `start`, on resolution level `level` (exposed for tests). With `basis`
   /// (3×k, orthonormal columns) the steps stay in the subspace it spans.
@@ -109,6 +118,9 @@ class ScanMatcher {
 
  private:
   Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& result) const;
+  /// True when H's translation block has a direction the scan barely constrains (degeneracy_ratio); that
+  /// direction (unit) into *weak.
+  bool degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* weak) const;
   /// The σ of the motion prior in effect: this scan's when given (>= 0), the config's otherwise.
   double priorSigma(double prior_sigma_xy) const {
     return prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy;

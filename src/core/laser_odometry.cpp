@@ -136,7 +136,8 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
   const double prior_sigma = config_.prior_acceleration > 0.0 && dt > 0.0 && dt <= config_.max_prior_gap
                                  ? 0.5 * config_.prior_acceleration * dt * dt
                                  : -1.0;
-  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma);
+  const bool may_release = config_.prior_release_speed > 0.0 && velocity_.head<2>().norm() < config_.prior_release_speed;
+  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release);
   if (!u.match.valid) {
     u.skip_reason = "match_failed";
     pose_ = prior;

@@ -48,6 +48,7 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
     require(o.degenerate_velocity_gain <= 1.0, "degenerate_velocity_gain", o.degenerate_velocity_gain, "must be <= 1");
   }
   nonNegative(s, "degenerate_velocity_max_range", o.degenerate_velocity_max_range);
+  nonNegative(s, "prior_release_speed", o.prior_release_speed);
   nonNegative(s, "map_voxel", o.map_voxel);
   atLeast(s, "min_points", o.min_points, 3);
   positive(s, "max_prior_gap", o.max_prior_gap);
@@ -95,6 +96,8 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   positive(s, "weak_inflation", m.weak_inflation);
   nonNegative(s, "rescue_margin", m.rescue_margin);
   positive(s, "rescue_window_theta", m.rescue_window_theta);
+  nonNegative(s, "prior_release_margin", m.prior_release_margin);
+  nonNegative(s, "prior_release_sigmas", m.prior_release_sigmas);
 }
 
 }  // namespace laser_dpslam

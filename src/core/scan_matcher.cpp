@@ -89,6 +89,13 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
   return pose;
 }
 
+bool ScanMatcher::degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* weak) const {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
+  et.computeDirect(Eigen::Matrix2d(0.5 * (hessian.topLeftCorner<2, 2>() + hessian.topLeftCorner<2, 2>().transpose())));
+  *weak = et.eigenvectors().col(0);
+  return !(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12));
+}
+
 Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& r) const {
   // Σ = α·H⁻¹ + Σ_min (algorithms.md §2 [P]): h is not a normalised likelihood, so H⁻¹ alone is
   // over-confident. H's eigenvalues are floored so that a singular H still gives a finite (large) Σ.
@@ -100,12 +107,9 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool
                         es.eigenvectors().transpose();
   // Degeneracy (corridors, a single wall): a translation direction the scan barely constrains. Say so in
   // the covariance with a large σ along it, rather than trusting a tiny curvature.
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
-  et.computeDirect(Eigen::Matrix2d(Hs.topLeftCorner<2, 2>()));
-  const double tmax = std::max(et.eigenvalues()(1), 1e-12);
-  r.degenerate = !(et.eigenvalues()(0) > config_.degeneracy_ratio * tmax);
+  Eigen::Vector2d v;
+  r.degenerate = degenerate(Hs, &v);
   if (r.degenerate) {
-    const Eigen::Vector2d v = et.eigenvectors().col(0);
     r.weak_direction = v;
     const double sigma = with_prior ? config_.degenerate_sigma_with_prior : config_.degenerate_sigma;
     cov.topLeftCorner<2, 2>() += sigma * sigma * v * v.transpose();
@@ -119,7 +123,7 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool
 
 MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
                                const std::vector<Eigen::Vector2d>& polish_points, const Pose2D& prior,
-                               std::mt19937_64& rng, double prior_sigma_xy) const {
+                               std::mt19937_64& rng, double prior_sigma_xy, bool allow_prior_release) const {
   MatchResult r;
   r.pose = prior;
   if (!hasReference() || points.empty() || polish_points.empty()) return r;
@@ -146,10 +150,10 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     return Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
   };
   // Newton polish coarse to fine, then the exact score at the finest resolution.
-  auto polishAll = [&](Pose2D pose, NdtScore* s) {
+  auto polishAll = [&](Pose2D pose, NdtScore* s, bool with_prior = true) {
     for (std::size_t level = 0; level < grids_.size(); ++level) {
       if (grids_[level].empty()) continue;
-      pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, &prior, prior_sigma_xy);
+      pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, with_prior ? &prior : nullptr, prior_sigma_xy);
     }
     *s = grids_.back().score(pose, polish_points, true);
     return pose;
@@ -185,16 +189,31 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
     // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
     // (LOAM-style solution remapping, Zhang et al. 2016).
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
-    et.computeDirect(Eigen::Matrix2d(0.5 * (s.hessian.topLeftCorner<2, 2>() + s.hessian.topLeftCorner<2, 2>().transpose())));
-    if (!(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12))) {
-      const Eigen::Vector2d v = et.eigenvectors().col(0);
+    Eigen::Vector2d v;
+    if (degenerate(s.hessian, &v)) {
       const Eigen::Vector2d d(pose.x - prior.x, pose.y - prior.y);
       const Eigen::Vector2d xy = Eigen::Vector2d(pose.x, pose.y) - v * v.dot(d);
       Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
       basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
       pose = polish(polish_points, Pose2D(xy.x(), xy.y(), pose.theta), grids_.size() - 1, &r.newton_iterations, &basis);
       s = grids_.back().score(pose, polish_points, true);
+    }
+  }
+  Eigen::Vector2d weak;
+  const double sigma = priorSigma(prior_sigma_xy);
+  if (allow_prior_release && sigma > 0.0 && degenerate(s.hessian, &weak)) {
+    // Along a corridor the soft prior holds the pose to the constant-velocity guess. When that guess is
+    // wrong (the robot starts to move while the estimate says it is at rest), the velocity smoothing
+    // follows the held motion only slowly and metres are lost in seconds (the loop building's start). The
+    // scan then fits clearly better where it really is: polish again without the prior and take that
+    // when it scores higher and lies well outside the prior's σ along the weak direction.
+    NdtScore fs;
+    const Pose2D free = polishAll(pose, &fs, false);
+    if (scorePerPoint(fs) > scorePerPoint(s) + config_.prior_release_margin &&
+        std::abs(weak.dot(Eigen::Vector2d(free.x - pose.x, free.y - pose.y))) > config_.prior_release_sigmas * sigma) {
+      pose = free;
+      s = fs;
+      r.prior_released = true;
     }
   }
   r.pose = pose;
