@@ -52,6 +52,27 @@ class DemoRunTest(unittest.TestCase):
         self.assertLess(final, 0.01 * travelled)
         self.assertLess(worst, 0.3)
 
+    def test_slam_log_follows_the_filter(self):
+        out = tempfile.mkdtemp()
+        log = os.path.join(out, "slam.csv")
+        p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", os.path.join(PKG, "bags", "demo.bag"),
+                            "--out", out, "--slam-log", log, "--quiet"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        rows = np.genfromtxt(log, delimiter=",", names=True)
+        self.assertEqual(rows.dtype.names, ("stamp", "ok", "x", "y", "theta", "sxx", "syy", "stt", "neff",
+                                            "resampled", "score_spread"))
+        self.assertEqual(len(rows), json.load(open(os.path.join(out, "stats.json")))["scans"])
+        self.assertTrue(np.all(np.diff(rows["stamp"]) > 0))
+        self.assertTrue(np.all((rows["neff"] > 0) & (rows["neff"] <= 30.0 + 1e-9)))
+        self.assertTrue(np.all(rows["sxx"] >= 0) and np.all(rows["stt"] >= 0))
+        self.assertGreater(int(rows["resampled"].sum()), 0)
+        # The best particle at the last scan is the one whose path trajectory.tum gives: same final pose.
+        t, x, y, th = load_tum(os.path.join(out, "trajectory.tum"))
+        self.assertAlmostEqual(rows["stamp"][-1], t[-1], places=5)
+        self.assertAlmostEqual(rows["x"][-1], x[-1], places=4)
+        self.assertAlmostEqual(rows["y"][-1], y[-1], places=4)
+        self.assertAlmostEqual(math.remainder(rows["theta"][-1] - th[-1], 2 * math.pi), 0.0, places=4)
+
 
 if __name__ == "__main__":
     unittest.main()

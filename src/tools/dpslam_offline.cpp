@@ -42,6 +42,7 @@ const char* kUsage =
     "                      [--odometry-only] [--base-frame base_link] [--laser-pose X Y YAW] [--quiet]\n"
     "                      [--match-log FILE.csv]   (one line per scan: the match's quality figures)\n"
     "                      [--memory-log FILE.csv]  (one line per scan: RSS, ancestry tree and map size)\n"
+    "                      [--slam-log FILE.csv]    (one line per scan: the filter's best pose, spread, Neff)\n"
     "                      [--loops N]              (replay the bag N times, as rosbag play -l would: time\n"
     "                                               goes back at each loop and everything starts over)\n"
     "Outputs are written at the end, stats.json last; a failed run (e.g. a corrupted bag) writes none.\n"
@@ -59,6 +60,7 @@ struct Args {
   bool quiet = false;
   std::string match_log;
   std::string memory_log;
+  std::string slam_log;
   int loops = 1;
 };
 
@@ -96,6 +98,7 @@ Args parseArgs(int argc, char** argv) {
     else if (f == "--quiet") a.quiet = true;
     else if (f == "--match-log") a.match_log = next();
     else if (f == "--memory-log") a.memory_log = next();
+    else if (f == "--slam-log") a.slam_log = next();
     else if (f == "--loops") {
       const double v = parseNumber(f, next());
       if (v < 1 || v > 1e6 || v != std::floor(v)) usageError("--loops expects a positive integer");
@@ -176,6 +179,7 @@ int main(int argc, char** argv) {
   }
 
   const bool show_progress = !args.quiet && ::isatty(STDOUT_FILENO);
+  std::string slam_log = "stamp,ok,x,y,theta,sxx,syy,stt,neff,resampled,score_spread\n";
   std::string match_log = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt\n";
   LaserOdometry odometry(odom_config);
   std::unique_ptr<DpSlam> slam;
@@ -312,6 +316,14 @@ int main(int argc, char** argv) {
           // Wall time: the SLAM scores particles on several threads.
           slam_ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count());
           if (!last_slam.ok) ++skipped["slam_" + last_slam.skip_reason];
+          if (!args.slam_log.empty()) {
+            char line[256];
+            std::snprintf(line, sizeof(line), "%.6f,%d,%.5f,%.5f,%.5f,%.3g,%.3g,%.3g,%.2f,%d,%.3f\n", scan.stamp, last_slam.ok,
+                          last_slam.pose.x, last_slam.pose.y, last_slam.pose.theta, last_slam.covariance(0, 0),
+                          last_slam.covariance(1, 1), last_slam.covariance(2, 2), last_slam.neff, last_slam.resampled,
+                          last_slam.score_spread);
+            slam_log += line;
+          }
           max_tree_nodes = std::max(max_tree_nodes, last_slam.tree_nodes);
           slam_last_odom = u.pose;
           slam_delta_cov.setZero();
@@ -359,6 +371,7 @@ int main(int argc, char** argv) {
       writeMapPng(grid, trajectory, args.out + "/map.png");
     }
     if (!args.match_log.empty()) writeFileAtomically(args.match_log, match_log);
+    if (!args.slam_log.empty() && slam) writeFileAtomically(args.slam_log, slam_log);
     std::string json = "{\n";
     json += "  \"scans\": " + std::to_string(total) + ",\n";
     json += "  \"data_duration_s\": " + jsonNumber(duration) + ",\n";
