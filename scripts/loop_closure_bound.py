@@ -9,7 +9,12 @@ SE(2) alignment, as tools/evaluate_trajectory scores it. If this bound is far ab
 alone (pose graph + loop closure) cannot reach the target from that front end: its local accuracy must
 improve first. Prints JSON: keyframes, closures, ate_estimate_m (at the keyframes), ate_bound_m.
 
-Usage: loop_closure_bound.py --estimate odometry.tum --reference ground_truth.tum [options]
+The odometry edges weigh the same everywhere unless --match-log gives dpslam_offline's match log of the
+same run: each edge then carries the odometry's own covariance (its per-scan delta variances summed between
+the keyframes), so a correction goes where the odometry was unsure (corridors, a start from rest) instead
+of being spread evenly.
+
+Usage: loop_closure_bound.py --estimate odometry.tum --reference ground_truth.tum [--match-log m.csv] [options]
 """
 import argparse
 import importlib.machinery
@@ -73,8 +78,29 @@ def ate(x, g):
     return float(np.sqrt(np.mean((ax - g[:, 0]) ** 2 + (ay - g[:, 1]) ** 2)))
 
 
+def load_match_log(path):
+    """stamp -> diagonal (x, y, theta) variance of that scan's delta (previous base frame), from
+    dpslam_offline --match-log."""
+    try:
+        rows = np.genfromtxt(path, delimiter=',', names=True, dtype=None, encoding=None)
+        return {round(float(r['stamp']), 6): (float(r['sxx']), float(r['syy']), float(r['stt'])) for r in np.atleast_1d(rows)}
+    except (OSError, ValueError, KeyError) as e:
+        raise ET.InputError('%s: not a readable dpslam_offline match log (%s)' % (path, e))
+
+
+def edge_information(est, first, last, variances):
+    """Information of the motion from pose `first` to pose `last`: the per-scan delta covariances in
+    between, rotated into the frame of pose `first` and summed."""
+    S = np.zeros((3, 3))
+    for i in range(first + 1, last + 1):
+        a = est[i - 1, 2] - est[first, 2]
+        R = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
+        S += R @ np.diag(variances[i]) @ R.T
+    return np.linalg.inv(S + 1e-12 * np.eye(3))
+
+
 def bound(est_path, ref_path, keyframe_distance=1.0, closure_radius=1.0, min_separation=20.0, closure_every=4,
-          odom_sigma=(0.01, 0.002), closure_sigma=(0.01, 0.002), seed=1):
+          odom_sigma=(0.01, 0.002), closure_sigma=(0.01, 0.002), seed=1, match_log=None):
     et, ex, ey, eth = ET.load_tum(est_path, 'estimate')
     rt, rx, ry, rth = ET.load_tum(ref_path, 'reference')
     keep = (et >= rt[0]) & (et <= rt[-1])
@@ -94,7 +120,17 @@ def bound(est_path, ref_path, keyframe_distance=1.0, closure_radius=1.0, min_sep
     x, g = est[kf], ref[kf]
     info_odom = np.diag([odom_sigma[0] ** -2, odom_sigma[0] ** -2, odom_sigma[1] ** -2])
     info_loop = np.diag([closure_sigma[0] ** -2, closure_sigma[0] ** -2, closure_sigma[1] ** -2])
-    edges = [(k, k + 1, relative(x[k], x[k + 1]), info_odom) for k in range(len(kf) - 1)]
+    if match_log is None:
+        edges = [(k, k + 1, relative(x[k], x[k + 1]), info_odom) for k in range(len(kf) - 1)]
+    else:
+        log = load_match_log(match_log)
+        missing = [t for t in et if round(float(t), 6) not in log]
+        if missing:
+            raise ET.InputError('%s has no line for %d estimate stamps (first %.6f): not the same run?'
+                                % (match_log, len(missing), missing[0]))
+        variances = [log[round(float(t), 6)] for t in et]
+        edges = [(k, k + 1, relative(x[k], x[k + 1]), edge_information(est, kf[k], kf[k + 1], variances))
+                 for k in range(len(kf) - 1)]
     path = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(g[:, 0]), np.diff(g[:, 1])))])
     rng = np.random.default_rng(seed)
     closures = 0
@@ -116,9 +152,12 @@ def main(argv=None):
     p.add_argument('--closure-radius', type=float, default=1.0, help='m; true distance of a revisit')
     p.add_argument('--min-separation', type=float, default=20.0, help='m of path before a revisit counts')
     p.add_argument('--seed', type=int, default=1, help='seed of the closures\' noise')
+    p.add_argument('--match-log', help='dpslam_offline --match-log of the same run: weight the odometry edges '
+                   'by its covariance (default: the same weight everywhere)')
     a = p.parse_args(argv)
     try:
-        out = bound(a.estimate, a.reference, a.keyframe_distance, a.closure_radius, a.min_separation, seed=a.seed)
+        out = bound(a.estimate, a.reference, a.keyframe_distance, a.closure_radius, a.min_separation, seed=a.seed,
+                    match_log=a.match_log)
     except ET.InputError as e:
         print('loop_closure_bound.py: %s' % e, file=sys.stderr)
         return 1
