@@ -56,7 +56,7 @@ struct LaserOdometryConfig {
   /// m/s; > 0: while the estimated speed is below this, a degenerate (corridor) match may drop the motion
   /// prior when the scan fits clearly better without it (ScanMatcherConfig::prior_release_margin). Starting
   /// from rest in a corridor, the prior says "at rest" and the smoothed velocity catches up slowly: the
-  /// loop building's start lost 0.6–1.2 m in 5 s (0.04–0.08 m with it; scripts/benchmark_loop.sh). 0 = off.
+  /// loop building's start lost 0.6–1.2 m in 5 s (0.04–0.12 m with it; scripts/benchmark_loop.sh). 0 = off.
   double prior_release_speed = 0.15;
   double map_voxel = 0.05;           ///< m, voxel size of the local map's points
   int min_points = 20;               ///< fewer valid points: the scan is skipped

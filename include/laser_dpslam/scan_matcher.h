@@ -65,7 +65,7 @@ struct ScanMatcherConfig {
   /// degenerate match held by the soft motion prior is polished again without it; the result replaces it when
   /// its score per point is higher by more than this and it lies more than prior_release_sigmas × the prior's
   /// σ away along the weak direction (the prior, not the scan, was wrong: a robot starting to move).
-  double prior_release_margin = 0.004;
+  double prior_release_margin = 0.005;
   double prior_release_sigmas = 3.0;   ///< see prior_release_margin
 };
 
