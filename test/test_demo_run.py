@@ -72,6 +72,11 @@ class DemoRunTest(unittest.TestCase):
         self.assertAlmostEqual(rows["x"][-1], x[-1], places=4)
         self.assertAlmostEqual(rows["y"][-1], y[-1], places=4)
         self.assertAlmostEqual(math.remainder(rows["theta"][-1] - th[-1], 2 * math.pi), 0.0, places=4)
+        # Without the SLAM there is nothing to log: a usage error, not a silently missing file.
+        p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", os.path.join(PKG, "bags", "demo.bag"),
+                            "--out", out, "--odometry-only", "--slam-log", log], capture_output=True, text=True)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("--slam-log", p.stderr)
 
 
 if __name__ == "__main__":

@@ -42,7 +42,8 @@ const char* kUsage =
     "                      [--odometry-only] [--base-frame base_link] [--laser-pose X Y YAW] [--quiet]\n"
     "                      [--match-log FILE.csv]   (one line per scan: the match's quality figures)\n"
     "                      [--memory-log FILE.csv]  (one line per scan: RSS, ancestry tree and map size)\n"
-    "                      [--slam-log FILE.csv]    (one line per scan: the filter's best pose, spread, Neff)\n"
+    "                      [--slam-log FILE.csv]    (one line per scan: the filter's best pose, spread, Neff;\n"
+    "                                               not with --odometry-only)\n"
     "                      [--loops N]              (replay the bag N times, as rosbag play -l would: time\n"
     "                                               goes back at each loop and everything starts over)\n"
     "Outputs are written at the end, stats.json last; a failed run (e.g. a corrupted bag) writes none.\n"
@@ -115,6 +116,7 @@ Args parseArgs(int argc, char** argv) {
   }
   if (a.bag.empty()) usageError("--bag is required");
   if (a.out.empty()) usageError("--out is required");
+  if (a.odometry_only && !a.slam_log.empty()) usageError("--slam-log needs the SLAM: drop --odometry-only");
   return a;
 }
 
@@ -371,7 +373,7 @@ int main(int argc, char** argv) {
       writeMapPng(grid, trajectory, args.out + "/map.png");
     }
     if (!args.match_log.empty()) writeFileAtomically(args.match_log, match_log);
-    if (!args.slam_log.empty() && slam) writeFileAtomically(args.slam_log, slam_log);
+    if (!args.slam_log.empty()) writeFileAtomically(args.slam_log, slam_log);
     std::string json = "{\n";
     json += "  \"scans\": " + std::to_string(total) + ",\n";
     json += "  \"data_duration_s\": " + jsonNumber(duration) + ",\n";
