@@ -166,6 +166,22 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   const bool de = config_.use_de && !raster_.empty();
   NdtScore s;
   Pose2D pose = polishAll(de ? deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng) : prior, &s);
+  const double prior_sigma = priorSigma(prior_sigma_xy);
+  if (de && prior_sigma > 0.0 && std::hypot(pose.x - prior.x, pose.y - prior.y) > 3.0 * prior_sigma) {
+    // The polish minimises h plus the soft prior, but DE searched h alone (on the raster) and may hand it a
+    // basin far from the prior (a corridor's flat score, a false optimum 0.2 m back). Polish from the prior
+    // too and keep the lower value of that same objective.
+    const double w = config_.covariance_scale / (prior_sigma * prior_sigma);
+    auto objective = [&](const Pose2D& p, const NdtScore& sc) {
+      return sc.h + 0.5 * w * ((p.x - prior.x) * (p.x - prior.x) + (p.y - prior.y) * (p.y - prior.y));
+    };
+    NdtScore ps;
+    const Pose2D from_prior = polishAll(prior, &ps);
+    if (objective(from_prior, ps) < objective(pose, s)) {
+      pose = from_prior;
+      s = ps;
+    }
+  }
   if (config_.rescue_margin > 0.0 && de && isWeak(s)) {
     // A weak match is often a wrong one (a fast turn starting: the constant-velocity prior is off and the
     // search ends on a false optimum). Try the prior itself and a search over a wider window; take one only
@@ -200,8 +216,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     }
   }
   Eigen::Vector2d weak;
-  const double sigma = priorSigma(prior_sigma_xy);
-  if (allow_prior_release && sigma > 0.0 && degenerate(s.hessian, &weak)) {
+  if (allow_prior_release && prior_sigma > 0.0 && degenerate(s.hessian, &weak)) {
     // Along a corridor the soft prior holds the pose to the constant-velocity guess. When that guess is
     // wrong (the robot starts to move while the estimate says it is at rest), the velocity smoothing
     // follows the held motion only slowly and metres are lost in seconds (the loop building's start). The
@@ -210,7 +225,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     NdtScore fs;
     const Pose2D free = polishAll(pose, &fs, false);
     if (scorePerPoint(fs) > scorePerPoint(s) + config_.prior_release_margin &&
-        std::abs(weak.dot(Eigen::Vector2d(free.x - pose.x, free.y - pose.y))) > config_.prior_release_sigmas * sigma) {
+        std::abs(weak.dot(Eigen::Vector2d(free.x - pose.x, free.y - pose.y))) > config_.prior_release_sigmas * prior_sigma) {
       pose = free;
       s = fs;
       r.prior_released = true;
@@ -222,7 +237,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   r.score_per_point = scorePerPoint(s);
   r.matched_fraction = static_cast<double>(s.matched) / n;
   r.weak = isWeak(s);
-  r.covariance = covarianceFrom(s.hessian, priorSigma(prior_sigma_xy) > 0.0, r);
+  r.covariance = covarianceFrom(s.hessian, prior_sigma > 0.0, r);
   r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
   if (!r.valid) r.pose = prior;
   return r;
