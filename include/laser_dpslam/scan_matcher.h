@@ -125,6 +125,12 @@ class ScanMatcher {
   double priorSigma(double prior_sigma_xy) const {
     return prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy;
   }
+  /// Weight w of the motion prior's penalty ½·w·|xy − prior|² in h's units (Σ = α·H⁻¹ ⇒ information α⁻¹·H);
+  /// 0 without a prior.
+  double priorWeight(double prior_sigma_xy) const {
+    const double sigma = priorSigma(prior_sigma_xy);
+    return sigma > 0.0 ? config_.covariance_scale / (sigma * sigma) : 0.0;
+  }
 
   ScanMatcherConfig config_;
   std::vector<NdtGrid> grids_;

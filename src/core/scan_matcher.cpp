@@ -31,9 +31,8 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
                            int* iterations, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis,
                            const Pose2D* prior, double prior_sigma_xy) const {
   const NdtGrid& grid = grids_.at(level);
-  // The motion prior as a quadratic term in h's units (Σ = α·H⁻¹ ⇒ information α⁻¹·H), see prior_sigma_xy.
-  const double sigma = priorSigma(prior_sigma_xy);
-  const double w = prior && sigma > 0.0 ? config_.covariance_scale / (sigma * sigma) : 0.0;
+  // The motion prior as a quadratic term in h's units, see prior_sigma_xy.
+  const double w = prior ? priorWeight(prior_sigma_xy) : 0.0;
   auto score = [&](const Pose2D& p) {
     NdtScore r = grid.score(p, points, true);
     if (w > 0.0) {
@@ -171,7 +170,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     // The polish minimises h plus the soft prior, but DE searched h alone (on the raster) and may hand it a
     // basin far from the prior (a corridor's flat score, a false optimum 0.2 m back). Polish from the prior
     // too and keep the lower value of that same objective.
-    const double w = config_.covariance_scale / (prior_sigma * prior_sigma);
+    const double w = priorWeight(prior_sigma_xy);
     auto objective = [&](const Pose2D& p, const NdtScore& sc) {
       return sc.h + 0.5 * w * ((p.x - prior.x) * (p.x - prior.x) + (p.y - prior.y) * (p.y - prior.y));
     };
