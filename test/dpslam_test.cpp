@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -269,6 +270,49 @@ TEST(DpSlam, UnusableScansMoveTheParticlesAndAreReported) {
   EXPECT_EQ(slam.particlePoses().size(), static_cast<std::size_t>(DpSlamConfig().particles));
 }
 
+// While the robot explores, the particles' own fresh maps cannot tell their spread apart and the proposal
+// noise only random-walks the filter; explore_noise_scale shrinks it there, and back on old ground (the
+// second lap) the full noise returns.
+TEST(DpSlam, ExploringShrinksTheProposalNoiseAndRevisitsRestoreIt) {
+  const SimRun& run = loopRun();
+  auto spreads = [&](double scale, std::vector<bool>* revisit) {
+    DpSlamConfig config;
+    config.explore_noise_scale = scale;
+    DpSlam slam(config);
+    std::vector<double> sd;
+    for (std::size_t i = 0; i < run.scans.size(); ++i) {
+      const DpSlamUpdate u = slam.process(run.scans[i].stamp, run.scans[i], LaserMount(), run.odometry[i].delta,
+                                          run.odometry[i].delta_covariance);
+      sd.push_back(std::sqrt(u.covariance(0, 0) + u.covariance(1, 1)));
+      if (revisit) revisit->push_back(u.revisit);
+    }
+    return sd;
+  };
+  std::vector<bool> revisit;
+  const std::vector<double> scaled = spreads(0.25, &revisit);
+  const std::vector<double> full = spreads(1.0, nullptr);
+  // The path is two laps of about 17 m: the first revisit comes after 10 m of travel, within the first lap's
+  // end, and most of the second lap is on old ground.
+  const std::size_t first = std::find(revisit.begin(), revisit.end(), true) - revisit.begin();
+  ASSERT_LT(first, revisit.size());
+  EXPECT_GT(first, 100u);
+  const std::size_t half = revisit.size() / 2;
+  EXPECT_GT(std::count(revisit.begin() + half, revisit.end(), true), static_cast<long>(0.8 * (revisit.size() - half)));
+  auto mean = [](const std::vector<double>& v, std::size_t a, std::size_t b) {
+    double m = 0.0;
+    for (std::size_t i = a; i < b; ++i) m += v[i];
+    return m / static_cast<double>(b - a);
+  };
+  // Exploring: a smaller spread (not a quarter: resampling and the scan likelihood shape it too). On old
+  // ground the scale does not apply: the same spread as with full noise throughout.
+  const double explore_scaled = mean(scaled, 10, first), explore_full = mean(full, 10, first);
+  std::printf("[ DpSlam   ] particle spread exploring %.4f m (scale 0.25) vs %.4f m (1); second lap %.4f vs %.4f m\n",
+              explore_scaled, explore_full, mean(scaled, half, scaled.size()), mean(full, half, full.size()));
+  EXPECT_LT(explore_scaled, 0.75 * explore_full);
+  EXPECT_NEAR(mean(scaled, half, scaled.size()) / mean(full, half, full.size()), 1.0, 0.2);
+  EXPECT_GT(mean(scaled, half, scaled.size()), 1.3 * explore_scaled);
+}
+
 TEST(DpSlam, InvalidConfigurationsAreRejected) {
   DpSlamConfig c;
   c.particles = 0;
@@ -278,5 +322,11 @@ TEST(DpSlam, InvalidConfigurationsAreRejected) {
   EXPECT_THROW(DpSlam{c}, std::invalid_argument);
   c = DpSlamConfig();
   c.threads = 0;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c = DpSlamConfig();
+  c.explore_noise_scale = 0.0;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c = DpSlamConfig();
+  c.revisit_radius = 0.0;
   EXPECT_THROW(DpSlam{c}, std::invalid_argument);
 }

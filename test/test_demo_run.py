@@ -60,12 +60,15 @@ class DemoRunTest(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         rows = np.genfromtxt(log, delimiter=",", names=True)
         self.assertEqual(rows.dtype.names, ("stamp", "ok", "x", "y", "theta", "sxx", "syy", "stt", "neff",
-                                            "resampled", "score_spread"))
+                                            "resampled", "score_spread", "revisit"))
         self.assertEqual(len(rows), json.load(open(os.path.join(out, "stats.json")))["scans"])
         self.assertTrue(np.all(np.diff(rows["stamp"]) > 0))
         self.assertTrue(np.all((rows["neff"] > 0) & (rows["neff"] <= 30.0 + 1e-9)))
         self.assertTrue(np.all(rows["sxx"] >= 0) and np.all(rows["stt"] >= 0))
         self.assertGreater(int(rows["resampled"].sum()), 0)
+        # The demo path starts on new ground and later comes back to where it started.
+        self.assertEqual(int(rows["revisit"][:100].sum()), 0)
+        self.assertGreater(int(rows["revisit"].sum()), 0)
         # The best particle at the last scan is the one whose path trajectory.tum gives: same final pose.
         t, x, y, th = load_tum(os.path.join(out, "trajectory.tum"))
         self.assertAlmostEqual(rows["stamp"][-1], t[-1], places=5)

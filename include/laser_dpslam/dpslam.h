@@ -17,6 +17,7 @@
 #include "laser_dpslam/occupancy_export.h"
 #include "laser_dpslam/particle_filter.h"
 #include "laser_dpslam/pose2d.h"
+#include "laser_dpslam/revisit_detector.h"
 #include "laser_dpslam/scan_preprocessor.h"
 #include "laser_dpslam/trajectory_io.h"
 
@@ -36,6 +37,13 @@ struct DpSlamConfig {
   double refine_step_theta = 0.005; ///< rad, first step of the hill climb
   int refine_halvings = 3;          ///< the climb stops after halving its steps this many times
   ProposalNoise proposal;           ///< noise added to the scan-match delta (see ProposalNoise)
+  /// Multiplies the proposal noise while the robot explores (no path of the best particle from at least
+  /// revisit_min_travel ago within revisit_radius): there the particles' own maps cannot tell their spread
+  /// apart, and noise only random-walks the filter away from its odometry; on revisits the full noise lets
+  /// it find the older map's alignment. 1 = off.
+  double explore_noise_scale = 0.25;
+  double revisit_radius = 2.0;       ///< m, see explore_noise_scale
+  double revisit_min_travel = 10.0;  ///< m of travel after which a stretch of path counts as old (revisitable)
   double min_travel_distance = 0.0;  ///< m; the filter updates once the robot moved this far ...
   double min_travel_angle = 0.0;     ///< rad; ... or turned this much since its last update (0 and 0 = every scan)
   // --- Map ---
@@ -73,6 +81,7 @@ struct DpSlamUpdate {
   bool resampled = false;
   double neff = 0.0;             ///< effective sample size after the update
   double score_spread = 0.0;     ///< best − worst log-likelihood of this scan over the particles (weight peakiness)
+  bool revisit = false;          ///< the filter update saw the robot on old ground (full proposal noise)
   std::size_t tree_nodes = 0;
   std::size_t map_entries = 0;
   std::size_t memory_bytes = 0;  ///< map + caches
@@ -148,6 +157,8 @@ class DpSlam {
 
   Eigen::Vector2d beam_origin_ = Eigen::Vector2d::Zero();  ///< laser position in the base frame
   std::vector<BaseBeam> score_beams_, update_beams_;
+  RevisitDetector revisit_;      ///< on the best particle's path: exploring or revisiting
+  bool last_revisit_ = false;
 };
 
 }  // namespace laser_dpslam

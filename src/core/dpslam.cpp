@@ -38,6 +38,9 @@ void DpSlamConfig::validate() const {
   require(proposal.covariance_scale >= 0.0, "proposal_covariance_scale must be >= 0");
   require(proposal.min_sigma_xy >= 0.0 && proposal.min_sigma_theta >= 0.0, "proposal minimum sigmas must be >= 0");
   require(proposal.sigma_xy_per_m >= 0.0 && proposal.sigma_theta_per_rad >= 0.0, "proposal sigma rates must be >= 0");
+  require(explore_noise_scale > 0.0 && explore_noise_scale <= 1.0, "explore_noise_scale must be in (0, 1]");
+  require(revisit_radius > 0.0, "revisit_radius must be > 0");
+  require(revisit_min_travel >= 0.0, "revisit_min_travel must be >= 0");
   require(min_travel_distance >= 0.0 && min_travel_angle >= 0.0, "minimum travel must be >= 0");
   require(map_resolution > 0.0, "map_resolution must be > 0");
   require(trace_max_range > map_resolution, "trace_max_range must exceed map_resolution");
@@ -59,6 +62,10 @@ void DpSlamConfig::validate() const {
 DpSlam::DpSlam(const DpSlamConfig& config)
     : config_(config), rng_(config.seed), map_(config.map_resolution, config.entry_prior_cells) {
   config_.validate();
+  RevisitDetectorConfig rc;
+  rc.radius = config_.revisit_radius;
+  rc.min_travel = config_.revisit_min_travel;
+  revisit_ = RevisitDetector(rc);
   pool_.reset(new WorkerPool(config_.threads));
   caches_.resize(static_cast<std::size_t>(config_.threads));
 }
@@ -80,6 +87,8 @@ void DpSlam::reset() {
   pending_cov_.setZero();
   since_map_update_ = Pose2D();
   force_map_update_ = false;
+  revisit_.reset();
+  last_revisit_ = false;
 }
 
 void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
@@ -262,7 +271,12 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
   const int P = config_.particles;
   const int K = config_.oversampling;
   // 1. Proposal: each particle moves by the delta plus noise, in its own frame. Draws in a fixed order.
-  const Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal);
+  Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal);
+  // Exploring, the noise mostly random-walks the particles (their fresh maps move with them); back on old
+  // ground it is what lets the filter find the older map's alignment (README "Benchmarks").
+  const Pose2D ahead = poses_[best_] * delta;
+  last_revisit_ = revisit_.update(Eigen::Vector2d(ahead.x, ahead.y), std::hypot(delta.x, delta.y));
+  if (!last_revisit_) L *= config_.explore_noise_scale;
   std::vector<Pose2D> chosen(P);
   std::vector<double> ll(P);
   for (auto& c : caches_) c.begin(tree_, leaves_);
@@ -370,6 +384,7 @@ void DpSlam::fill(DpSlamUpdate& u) const {
     u.covariance = weightedPoseCovariance(poses, w);
   }
   u.neff = last_neff_;
+  u.revisit = last_revisit_;
   u.tree_nodes = tree_.size();
   u.map_entries = map_.entryCount();
   u.memory_bytes = memoryBytes();

@@ -41,6 +41,12 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   nonNegative(s, "proposal_sigma_theta_per_rad", c.proposal.sigma_theta_per_rad);
   positive(s, "proposal_max_sigma_xy", c.proposal.max_sigma_xy);
   positive(s, "proposal_max_sigma_theta", c.proposal.max_sigma_theta);
+  if (s.get("explore_noise_scale", c.explore_noise_scale)) {
+    require(c.explore_noise_scale > 0.0 && c.explore_noise_scale <= 1.0, "explore_noise_scale", c.explore_noise_scale,
+            "must be in (0, 1]");
+  }
+  positive(s, "revisit_radius", c.revisit_radius);
+  nonNegative(s, "revisit_min_travel", c.revisit_min_travel);
   nonNegative(s, "min_travel_distance", c.min_travel_distance);
   nonNegative(s, "min_travel_angle", c.min_travel_angle);
 

@@ -181,7 +181,7 @@ int main(int argc, char** argv) {
   }
 
   const bool show_progress = !args.quiet && ::isatty(STDOUT_FILENO);
-  std::string slam_log = "stamp,ok,x,y,theta,sxx,syy,stt,neff,resampled,score_spread\n";
+  std::string slam_log = "stamp,ok,x,y,theta,sxx,syy,stt,neff,resampled,score_spread,revisit\n";
   std::string match_log = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt\n";
   LaserOdometry odometry(odom_config);
   std::unique_ptr<DpSlam> slam;
@@ -320,10 +320,10 @@ int main(int argc, char** argv) {
           if (!last_slam.ok) ++skipped["slam_" + last_slam.skip_reason];
           if (!args.slam_log.empty()) {
             char line[256];
-            std::snprintf(line, sizeof(line), "%.6f,%d,%.5f,%.5f,%.5f,%.3g,%.3g,%.3g,%.2f,%d,%.3f\n", scan.stamp, last_slam.ok,
+            std::snprintf(line, sizeof(line), "%.6f,%d,%.5f,%.5f,%.5f,%.3g,%.3g,%.3g,%.2f,%d,%.3f,%d\n", scan.stamp, last_slam.ok,
                           last_slam.pose.x, last_slam.pose.y, last_slam.pose.theta, last_slam.covariance(0, 0),
                           last_slam.covariance(1, 1), last_slam.covariance(2, 2), last_slam.neff, last_slam.resampled,
-                          last_slam.score_spread);
+                          last_slam.score_spread, last_slam.revisit);
             slam_log += line;
           }
           max_tree_nodes = std::max(max_tree_nodes, last_slam.tree_nodes);
