@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <random>
 #include <string>
@@ -288,4 +292,40 @@ TEST(ScanMatcher, SoftPriorKeepsTheBasinAtThePriorWhenDeEndsInAnother) {
   ASSERT_TRUE(r.valid);
   EXPECT_LT(std::hypot(r.pose.x - rec.prior.x, r.pose.y - rec.prior.y), 3.0 * rec.prior_sigma);
   EXPECT_LT(std::abs(r.pose.theta - rec.prior.theta), 0.02);
+}
+
+// Where H is singular or indefinite — a polish that stopped on a ridge of h in heading, a scene that does not
+// fix the heading — the match covariance has σ of metres to tens of radians along that direction (the demo
+// bag at t = 1025.0 s: σ_θ ≈ 58 rad, σ_xy ≈ 20 m, no flag). The SLAM's proposal uses it as it is; the
+// odometry's pose covariance, summed over the run, stayed that large for the rest of it. boundedByWindow
+// scales it to what the search alone says (σ ≤ w/√3, uniform over the window; in translation no less than
+// degenerate_sigma), keeping the translation's direction and the correlations, and leaves a clear match's
+// covariance alone.
+TEST(ScanMatcher, CovarianceBoundedByTheSearchWindow) {
+  ScanMatcherConfig c;
+  c.rescue_margin = 0.0;  // the search window is then ±window_theta
+  const ScanMatcher m(c);
+  const double cap_xy = std::max(c.window_xy / std::sqrt(3.0), c.degenerate_sigma);
+  const double cap_th = c.window_theta / std::sqrt(3.0);
+  // Huge along a ridge direction mixing heading and translation, small elsewhere.
+  const Eigen::Vector3d v = Eigen::Vector3d(0.3, -0.1, 1.0).normalized();
+  const Eigen::Matrix3d huge = 3e3 * v * v.transpose() + Eigen::Vector3d(1e-4, 4e-5, 1e-5).asDiagonal().toDenseMatrix();
+  const Eigen::Matrix3d b = m.boundedByWindow(huge);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et(b.topLeftCorner<2, 2>());
+  EXPECT_NEAR(std::sqrt(et.eigenvalues()(1)), cap_xy, 1e-9);
+  EXPECT_NEAR(std::sqrt(b(2, 2)), cap_th, 1e-9);
+  EXPECT_NEAR(b(0, 0) / b(1, 1), huge(0, 0) / huge(1, 1), 1e-9);                            // direction kept
+  EXPECT_NEAR(b(0, 2) / std::sqrt(b(0, 0) * b(2, 2)), huge(0, 2) / std::sqrt(huge(0, 0) * huge(2, 2)), 1e-9);  // correlation kept
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b).eigenvalues()(0), 0.0);
+  // The same in another frame (the odometry applies it to the delta's, rotated into the base frame).
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  R.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(0.7).toRotationMatrix();
+  EXPECT_LT((m.boundedByWindow(R.transpose() * huge * R) - R.transpose() * b * R).cwiseAbs().maxCoeff(), 1e-12);
+  // A clear match is left as it was.
+  const Eigen::Matrix3d small = Eigen::Vector3d(4e-4, 2.5e-4, 1e-4).asDiagonal();
+  EXPECT_EQ(m.boundedByWindow(small), small);
+  // With the rescue on, the heading may come from its wider window.
+  ScanMatcherConfig cr;
+  cr.rescue_margin = 0.05;
+  EXPECT_NEAR(std::sqrt(ScanMatcher(cr).boundedByWindow(huge)(2, 2)), std::max(cr.window_theta, cr.rescue_window_theta) / std::sqrt(3.0), 1e-9);
 }

@@ -72,7 +72,12 @@ struct ScanMatcherConfig {
 struct MatchResult {
   bool valid = false;                         ///< false: nothing to match against or no points
   Pose2D pose;                                ///< pose of the scan's frame in the reference frame
+  /// α·H⁻¹ + Σ_min (inflated when weak or degenerate). Where H is singular or indefinite it is huge along
+  /// that direction ("unknown"): the SLAM's proposal uses it so (it caps the σ itself).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  /// The same with |H|'s eigenvalues and within the search window (boundedByWindow): what the odometry's
+  /// pose covariance accumulates.
+  Eigen::Matrix3d bounded_covariance = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();  ///< of h at the optimum (finest resolution)
   double score_per_point = 0.0;   ///< −h / (4·points) in [0, 1]: 1 = every point on a cell mean
   double matched_fraction = 0.0;  ///< points within 3σ of a cell
@@ -115,6 +120,13 @@ class ScanMatcher {
 
   const ScanMatcherConfig& config() const { return config_; }
   const NdtGrid& grid(std::size_t level) const { return grids_.at(level); }
+
+  /// `cov` (a match's, or the same rotated into another frame) scaled down to what the search window
+  /// alone says: σ ≤ w/√3. Where the Hessian is singular or indefinite (a polish stopped on a ridge of h,
+  /// a scene that does not fix the heading) MatchResult::covariance has σ of metres to tens of radians
+  /// along that direction; the SLAM's proposal uses that direction as it is (it caps the σ itself), a pose
+  /// covariance accumulated over a run should not carry it (LaserOdometry).
+  Eigen::Matrix3d boundedByWindow(const Eigen::Matrix3d& cov) const;
 
  private:
   Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& result) const;

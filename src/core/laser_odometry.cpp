@@ -156,7 +156,9 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
   u.delta_covariance = R.transpose() * u.match.covariance * R;
   Eigen::Matrix3d Ja, Jb;
   composeJacobians(previous, u.delta, &Ja, &Jb);
-  pose_covariance_ = Ja * pose_covariance_ * Ja.transpose() + Jb * u.delta_covariance * Jb.transpose();
+  // The delta's covariance is the matcher's as it is (the SLAM's proposal follows its direction even where
+  // it is huge); the pose covariance, which sums them over the run, takes the bounded one.
+  pose_covariance_ = Ja * pose_covariance_ * Ja.transpose() + Jb * (R.transpose() * u.match.bounded_covariance * R) * Jb.transpose();
   if (dt > 0.0 && dt <= config_.max_prior_gap) {
     // Translation: exponential smoothing (velocity_gain). Taking the last motion as the velocity feeds any
     // small per-match bias along a corridor back into the prior, where it adds up twice (a lag growing with

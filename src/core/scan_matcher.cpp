@@ -101,23 +101,49 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool
   const Eigen::Matrix3d Hs = 0.5 * (hessian + hessian.transpose());
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
   es.computeDirect(Hs);
-  const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(1e-9 * std::max(es.eigenvalues().maxCoeff(), 1e-9));
-  Eigen::Matrix3d cov = config_.covariance_scale * es.eigenvectors() * ev.cwiseInverse().asDiagonal() *
-                        es.eigenvectors().transpose();
+  const double floor = 1e-9 * std::max(es.eigenvalues().maxCoeff(), 1e-9);
   // Degeneracy (corridors, a single wall): a translation direction the scan barely constrains. Say so in
   // the covariance with a large σ along it, rather than trusting a tiny curvature.
   Eigen::Vector2d v;
   r.degenerate = degenerate(Hs, &v);
-  if (r.degenerate) {
-    r.weak_direction = v;
-    const double sigma = with_prior ? config_.degenerate_sigma_with_prior : config_.degenerate_sigma;
-    cov.topLeftCorner<2, 2>() += sigma * sigma * v * v.transpose();
-  }
-  cov(0, 0) += config_.min_sigma_xy * config_.min_sigma_xy;
-  cov(1, 1) += config_.min_sigma_xy * config_.min_sigma_xy;
-  cov(2, 2) += config_.min_sigma_theta * config_.min_sigma_theta;
-  if (r.weak) cov *= config_.weak_inflation;
-  return 0.5 * (cov + cov.transpose());
+  if (r.degenerate) r.weak_direction = v;
+  auto fromEigenvalues = [&](const Eigen::Vector3d& ev) {
+    Eigen::Matrix3d cov = config_.covariance_scale * es.eigenvectors() * ev.cwiseMax(floor).cwiseInverse().asDiagonal() *
+                          es.eigenvectors().transpose();
+    if (r.degenerate) {
+      const double sigma = with_prior ? config_.degenerate_sigma_with_prior : config_.degenerate_sigma;
+      cov.topLeftCorner<2, 2>() += sigma * sigma * v * v.transpose();
+    }
+    cov(0, 0) += config_.min_sigma_xy * config_.min_sigma_xy;
+    cov(1, 1) += config_.min_sigma_xy * config_.min_sigma_xy;
+    cov(2, 2) += config_.min_sigma_theta * config_.min_sigma_theta;
+    if (r.weak) cov *= config_.weak_inflation;
+    return Eigen::Matrix3d(0.5 * (cov + cov.transpose()));
+  };
+  // Where the polish ended on a ridge (H indefinite: h curves down, typically in heading) a negative
+  // eigenvalue is floored to nothing, which says "unknown" along it; the SLAM's proposal spreads its
+  // particles along that direction and is better for it (README "Reliability"). The pose covariance takes
+  // the curvature's magnitude instead (how fast h changes there: saddle-free, Dauphin et al. 2014), within
+  // the search window.
+  r.bounded_covariance = boundedByWindow(fromEigenvalues(es.eigenvalues().cwiseAbs()));
+  return fromEigenvalues(es.eigenvalues());
+}
+
+Eigen::Matrix3d ScanMatcher::boundedByWindow(const Eigen::Matrix3d& cov) const {
+  // The search knows the pose lies within ±window of the prior (±rescue_window_theta for a retried weak
+  // match), at worst uniformly: σ = w/√3 (in translation no less than degenerate_sigma, the σ a corridor
+  // is given). Translation (by its largest σ, so its direction is kept) and heading are scaled down to
+  // that; the correlations are kept.
+  const double wt = config_.rescue_margin > 0.0 ? std::max(config_.window_theta, config_.rescue_window_theta) : config_.window_theta;
+  const double cap_xy = std::max(config_.window_xy / std::sqrt(3.0), config_.degenerate_sigma);
+  const double cap_theta = wt / std::sqrt(3.0);
+  Eigen::Matrix3d c = 0.5 * (cov + cov.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
+  et.computeDirect(Eigen::Matrix2d(c.topLeftCorner<2, 2>()), Eigen::EigenvaluesOnly);
+  const double sd_xy = std::sqrt(std::max(0.0, et.eigenvalues()(1))), sd_theta = std::sqrt(std::max(0.0, c(2, 2)));
+  const double fxy = sd_xy > cap_xy ? cap_xy / sd_xy : 1.0, ftheta = sd_theta > cap_theta ? cap_theta / sd_theta : 1.0;
+  const Eigen::Vector3d f(fxy, fxy, ftheta);
+  return f.asDiagonal() * c * f.asDiagonal();
 }
 
 MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,

@@ -188,6 +188,7 @@ int main(int argc, char** argv) {
   if (!args.odometry_only) slam = std::make_unique<DpSlam>(slam_config);
   Pose2D slam_last_odom;               // odometry pose of the last scan given to the SLAM
   Eigen::Matrix3d slam_delta_cov = Eigen::Matrix3d::Zero();  // accumulated since then
+  Eigen::Matrix3d odom_last_covariance = Eigen::Matrix3d::Zero();  // the odometry's pose covariance at the last scan
   bool slam_has_last = false;
   std::vector<double> slam_ms;
   DpSlamUpdate last_slam;
@@ -309,6 +310,7 @@ int main(int argc, char** argv) {
           continue;
         }
         odom_poses.push_back({scan.stamp, u.pose});
+        odom_last_covariance = u.pose_covariance;
         last_stamp = scan.stamp;
         if (slam) {
           slam_delta_cov += u.delta_covariance;
@@ -391,6 +393,10 @@ int main(int argc, char** argv) {
       json += "  \"slam_memory_mb\": " + jsonNumber(last_slam.memory_bytes / 1048576.0) + ",\n";
     }
     json += "  \"seed\": " + std::to_string(odom_config.seed) + ",\n";
+    // The odometry's own pose uncertainty at the end (what /odom's pose covariance says): σ x, y, θ.
+    json += "  \"odometry_final_sigma\": {\"x_m\": " + jsonNumber(std::sqrt(odom_last_covariance(0, 0))) +
+            ", \"y_m\": " + jsonNumber(std::sqrt(odom_last_covariance(1, 1))) +
+            ", \"theta_rad\": " + jsonNumber(std::sqrt(odom_last_covariance(2, 2))) + "},\n";
     json += "  \"bad_match_percent\": " + jsonNumber(matched ? 100.0 * bad / matched : 0.0) + ",\n";
     json += "  \"resampling\": " + jsonString(resamplingMethodName(odom_config.resampling)) + ",\n";
     json += std::string("  \"mode\": ") + (slam ? "\"slam\"" : "\"odometry-only\"") + ",\n";
