@@ -97,6 +97,7 @@ class LaserOdometry {
  private:
   struct Keyframe {
     Pose2D pose;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of `pose`, odom frame
     std::vector<Eigen::Vector2d> points;  ///< in the odom frame
   };
   void addKeyframe(const std::vector<Eigen::Vector2d>& base_points);

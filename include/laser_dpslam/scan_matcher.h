@@ -113,10 +113,11 @@ class ScanMatcher {
                     bool allow_prior_release = false) const;
 
   /// Newton polish only, from `start`, on resolution level `level` (exposed for tests). With `basis`
-  /// (3×k, orthonormal columns) the steps stay in the subspace it spans.
+  /// (3×k, orthonormal columns) the steps stay in the subspace it spans. `final_score`: the level's NDT
+  /// score (without the prior's term) at the returned pose, with derivatives.
   Pose2D polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
                 int* iterations = nullptr, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis = nullptr,
-                const Pose2D* prior = nullptr, double prior_sigma_xy = -1.0) const;
+                const Pose2D* prior = nullptr, double prior_sigma_xy = -1.0, NdtScore* final_score = nullptr) const;
 
   const ScanMatcherConfig& config() const { return config_; }
   const NdtGrid& grid(std::size_t level) const { return grids_.at(level); }

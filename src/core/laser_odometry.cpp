@@ -22,6 +22,7 @@ void LaserOdometry::reset() {
 void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points) {
   Keyframe kf;
   kf.pose = pose_;
+  kf.covariance = pose_covariance_;
   kf.points.reserve(base_points.size());
   for (const auto& p : base_points) kf.points.push_back(pose_.transform(p));
   kf.points = voxelFilter(kf.points, config_.map_voxel);
@@ -154,11 +155,16 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   R.topLeftCorner<2, 2>() = previous.rotation();
   u.delta_covariance = R.transpose() * u.match.covariance * R;
-  Eigen::Matrix3d Ja, Jb;
-  composeJacobians(previous, u.delta, &Ja, &Jb);
   // The delta's covariance is the matcher's as it is (the SLAM's proposal follows its direction even where
-  // it is huge); the pose covariance, which sums them over the run, takes the bounded one.
-  pose_covariance_ = Ja * pose_covariance_ * Ja.transpose() + Jb * (R.transpose() * u.match.bounded_covariance * R) * Jb.transpose();
+  // it is huge); the pose covariance takes the bounded one. The scan was matched against the local map, not
+  // the previous scan, so its error does not add up scan by scan: the pose is the newest keyframe's (whose
+  // covariance was fixed when it was taken) composed with this match, Σ = Ja·Σ_kf·Jaᵀ + Σ_match (odom
+  // frame). Summing every scan's match instead overstated σ about fivefold (demo: 0.51 m after 24 m, real
+  // error 0.054 m).
+  const Keyframe& kf = keyframes_.back();
+  Eigen::Matrix3d Ja, Jb;
+  composeJacobians(kf.pose, between(kf.pose, pose_), &Ja, &Jb);
+  pose_covariance_ = Ja * kf.covariance * Ja.transpose() + u.match.bounded_covariance;
   if (dt > 0.0 && dt <= config_.max_prior_gap) {
     // Translation: exponential smoothing (velocity_gain). Taking the last motion as the velocity feeds any
     // small per-match bias along a corridor back into the prior, where it adds up twice (a lag growing with

@@ -222,26 +222,38 @@ std::vector<int> saliencyResample(const PreprocessedScan& scan, std::size_t budg
 
   // Phase 2: coverage by farthest-point sampling from what is already chosen: spatially uniform, so the
   // dense clusters near the laser do not take the budget (the thesis's URG-04LX problem).
-  // The distance update and the next arg-max share one pass: O(n) per pick.
-  std::vector<double> dist2(n, std::numeric_limits<double>::infinity());
-  for (int j : out)
-    for (std::size_t i = 0; i < n; ++i) dist2[i] = std::min(dist2[i], (p[i] - p[j]).squaredNorm());
-  int best = -1;
-  double best_d = -1.0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (eligible[i] && !chosen[i] && dist2[i] > best_d) best_d = dist2[i], best = static_cast<int>(i);
-  while (out.size() < budget && best >= 0) {
-    out.push_back(best);
-    chosen[best] = 1;
-    const Eigen::Vector2d q = p[best];
-    best = -1;
-    best_d = -1.0;
+  // O(n) per pick over plain arrays (the scan's hot loop after the NDT score): points that may not be
+  // picked carry −inf, which min() keeps and the arg-max never takes.
+  std::vector<double> xs(n), ys(n), dist2(n, std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i] = p[i].x();
+    ys[i] = p[i].y();
+    if (!eligible[i] || chosen[i]) dist2[i] = -std::numeric_limits<double>::infinity();
+  }
+  // Adds point j to the picks; returns the farthest point from all picks (−1: none left).
+  auto pick = [&](std::size_t j) {
+    const double qx = xs[j], qy = ys[j];
+    int best = -1;
+    double best_d = -1.0;
     for (std::size_t i = 0; i < n; ++i) {
-      if (!eligible[i] || chosen[i]) continue;
-      const double d = std::min(dist2[i], (p[i] - q).squaredNorm());
+      const double dx = xs[i] - qx, dy = ys[i] - qy;
+      const double d = std::min(dist2[i], dx * dx + dy * dy);
       dist2[i] = d;
       if (d > best_d) best_d = d, best = static_cast<int>(i);
     }
+    return best;
+  };
+  int best = -1;
+  if (out.empty()) {
+    for (std::size_t i = 0; i < n && best < 0; ++i)
+      if (dist2[i] > 0.0) best = static_cast<int>(i);
+  }
+  for (int j : out) best = pick(static_cast<std::size_t>(j));
+  while (out.size() < budget && best >= 0) {
+    out.push_back(best);
+    chosen[best] = 1;
+    dist2[best] = -std::numeric_limits<double>::infinity();
+    best = pick(static_cast<std::size_t>(best));
   }
   std::sort(out.begin(), out.end());
   return out;

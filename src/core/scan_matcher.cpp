@@ -29,12 +29,14 @@ bool ScanMatcher::hasReference() const { return !grids_.empty() && !grids_.back(
 
 Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
                            int* iterations, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis,
-                           const Pose2D* prior, double prior_sigma_xy) const {
+                           const Pose2D* prior, double prior_sigma_xy, NdtScore* final_score) const {
   const NdtGrid& grid = grids_.at(level);
   // The motion prior as a quadratic term in h's units, see prior_sigma_xy.
   const double w = prior ? priorWeight(prior_sigma_xy) : 0.0;
-  auto score = [&](const Pose2D& p) {
+  // `raw` receives the score without the prior's term.
+  auto score = [&](const Pose2D& p, NdtScore* raw) {
     NdtScore r = grid.score(p, points, true);
+    *raw = r;
     if (w > 0.0) {
       const Eigen::Vector2d d(p.x - prior->x, p.y - prior->y);
       r.h += 0.5 * w * d.squaredNorm();
@@ -44,7 +46,8 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
     return r;
   };
   Pose2D pose = start;
-  NdtScore s = score(pose);
+  NdtScore raw;
+  NdtScore s = score(pose, &raw);
   int it = 0;
   for (; it < config_.newton_iterations; ++it) {
     // Newton with the Hessian made positive definite (algorithms.md §2).
@@ -68,10 +71,12 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
     for (int k = 0; k < 6; ++k) {
       const Pose2D cand(pose.x + step * delta.x(), pose.y + step * delta.y(),
                         normalizeAngle(pose.theta + step * delta.z()));
-      NdtScore cs = score(cand);
+      NdtScore craw;
+      NdtScore cs = score(cand, &craw);
       if (cs.h <= s.h) {
         pose = cand;
         s = cs;
+        raw = craw;
         improved = true;
         break;
       }
@@ -85,6 +90,7 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
     }
   }
   if (iterations) *iterations += it;
+  if (final_score) *final_score = raw;
   return pose;
 }
 
@@ -175,12 +181,16 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     return Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
   };
   // Newton polish coarse to fine, then the exact score at the finest resolution.
+  // (The finest level's polish already scored its final pose: that score is reused.)
   auto polishAll = [&](Pose2D pose, NdtScore* s, bool with_prior = true) {
+    bool scored = false;
     for (std::size_t level = 0; level < grids_.size(); ++level) {
       if (grids_[level].empty()) continue;
-      pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, with_prior ? &prior : nullptr, prior_sigma_xy);
+      pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, with_prior ? &prior : nullptr,
+                    prior_sigma_xy, s);
+      scored = level + 1 == grids_.size();
     }
-    *s = grids_.back().score(pose, polish_points, true);
+    if (!scored) *s = grids_.back().score(pose, polish_points, true);
     return pose;
   };
   const double n = static_cast<double>(polish_points.size());
