@@ -76,7 +76,7 @@ struct MatchResult {
   /// that direction ("unknown"): the SLAM's proposal uses it so (it caps the σ itself).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   /// The same with |H|'s eigenvalues and within the search window (boundedByWindow): what the odometry's
-  /// pose covariance accumulates.
+  /// pose covariance is built from (the newest keyframe's covariance plus this).
   Eigen::Matrix3d bounded_covariance = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();  ///< of h at the optimum (finest resolution)
   double score_per_point = 0.0;   ///< −h / (4·points) in [0, 1]: 1 = every point on a cell mean
