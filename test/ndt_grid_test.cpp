@@ -118,3 +118,50 @@ TEST(NdtGrid, NonFinitePointsAreIgnored) {
   EXPECT_TRUE(std::isfinite(s.h));
   EXPECT_TRUE(s.gradient.allFinite());
 }
+
+// ndt_point_sigma: a point with that noise at its cell's mean scores 1 on average in a thin and in a fat
+// cell alike (weight = det(I + σ²Σ⁻¹)^½); the plain score gives the thin cell much less.
+TEST(NdtGrid, PointSigmaWeightEqualisesTheExpectedScoreOfNoisyPoints) {
+  NdtGridConfig c;
+  c.cell_size = 1.0;
+  c.point_sigma = 0.01;
+  std::vector<Eigen::Vector2d> pts;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0.0, 0.002), noise(0.0, c.point_sigma);
+  for (double x = 0.05; x < 0.95; x += 0.01) pts.emplace_back(x, 0.5 + n(rng));                 // a thin wall
+  for (double a = 0; a < 2 * M_PI; a += 0.05) pts.emplace_back(5.5 + 0.3 * std::cos(a), 5.5 + 0.3 * std::sin(a));  // a fat ring
+  NdtGrid g(pts, c);
+  NdtGridConfig plain_config = c;
+  plain_config.point_sigma = 0.0;
+  NdtGrid plain(pts, plain_config);
+  int thin = 0, fat = 0;
+  for (const auto& layer : g.layers()) {
+    for (std::size_t i = 0; i < layer.cells.size(); ++i) {
+      const NdtCell& cell = layer.cells[i];
+      if (!cell.valid) continue;
+      EXPECT_GE(cell.weight, 1.0);
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cell.covariance);
+      const double ev0 = es.eigenvalues()(0), ev1 = es.eigenvalues()(1);
+      EXPECT_NEAR(cell.weight, std::sqrt((1 + 1e-4 / ev0) * (1 + 1e-4 / ev1)), 1e-9);
+      // Monte Carlo: the weighted exp() term of noisy points at the mean averages 1.
+      double mean = 0.0, mean_plain = 0.0;
+      const int N = 20000;
+      for (int k = 0; k < N; ++k) {
+        const Eigen::Vector2d q(noise(rng), noise(rng));
+        const double e = std::exp(-0.5 * q.dot(cell.information * q));
+        mean += cell.weight * e / N;
+        mean_plain += e / N;
+      }
+      EXPECT_NEAR(mean, 1.0, 0.02);
+      if (ev0 < 1e-4) {
+        EXPECT_LT(mean_plain, 0.8);  // a thin cell: the plain term loses > 20 %
+        ++thin;
+      } else {
+        ++fat;
+      }
+      EXPECT_EQ(plain.layers()[&layer - &g.layers()[0]].cells[i].weight, 1.0);
+    }
+  }
+  EXPECT_GT(thin, 0);
+  EXPECT_GT(fat, 0);
+}

@@ -17,6 +17,9 @@ struct NdtGridConfig {
   int min_points = 3;          ///< a cell needs this many points to get a Gaussian (thesis: 3)
   double eigen_ratio = 0.001;  ///< smallest covariance eigenvalue is raised to this × the largest
   double min_eigen = 1e-5;     ///< m², absolute floor of the eigenvalues (a perfectly straight wall)
+  double point_sigma = 0.0;    ///< m, noise of a matched point; each cell's term is scaled so that such a point at
+                               ///< its true place scores the same on average in a thin (wall) and a fat (corner)
+                               ///< cell; 0 = off (the plain Biber score)
 };
 
 /// One Gaussian of the NDT. The inverse covariance is precomputed: it is what the score needs.
@@ -24,6 +27,7 @@ struct NdtCell {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  double weight = 1.0;  ///< scale of this cell's exp() term (NdtGridConfig::point_sigma)
   int count = 0;
   bool valid = false;
 };

@@ -73,6 +73,11 @@ void NdtGrid::build(const std::vector<Eigen::Vector2d>& points, const NdtGridCon
       const Eigen::Matrix2d& V = es.eigenvectors();
       c.covariance = V * ev.asDiagonal() * V.transpose();
       c.information = V * ev.cwiseInverse().asDiagonal() * V.transpose();
+      // A point with isotropic noise σ at its true place scores E[exp(−½qᵀΣ⁻¹q)] = det(I + σ²Σ⁻¹)^(−½)
+      // on average: less in a thin wall cell than in a fat corner cell, so the plain score pulls noisy
+      // scans towards corners, along corridors most of all. The weight undoes that.
+      const double s2 = config.point_sigma * config.point_sigma;
+      c.weight = std::sqrt((1.0 + s2 / ev(0)) * (1.0 + s2 / ev(1)));
       c.valid = true;
       ++valid_cells_;
     }
@@ -86,7 +91,7 @@ double NdtGrid::density(const Eigen::Vector2d& p) const {
     const NdtCell* c = layer.cellAt(p, inv);
     if (!c) continue;
     const Eigen::Vector2d q = p - c->mean;
-    s += std::exp(-0.5 * q.dot(c->information * q));
+    s += c->weight * std::exp(-0.5 * q.dot(c->information * q));
   }
   return s;
 }
@@ -116,7 +121,7 @@ NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& 
       const double m2 = qx * iqx + qy * iqy;
       if (m2 < 9.0) matched = true;
       if (m2 > 40.0) continue;  // exp(−20) ≈ 2e-9: no contribution worth an exp()
-      const double e = std::exp(-0.5 * m2);
+      const double e = cell->weight * std::exp(-0.5 * m2);
       h -= e;
       if (!derivatives) continue;
       // g_k = e·qᵀΣ⁻¹J_k with J = [e_x, e_y, j_θ].

@@ -43,7 +43,7 @@ void NdtScoreRaster::build(const NdtGrid& grid, double resolution) {
           for (int ix = ix0; ix <= ix1; ++ix) {
             const double qx = origin_.x() + ix * resolution_ - cell.mean.x();
             const double m2 = a * qx * qx + 2.0 * b * qx * qy + c * qy * qy;
-            if (m2 < 50.0) row[ix] += static_cast<float>(std::exp(-0.5 * m2));
+            if (m2 < 50.0) row[ix] += static_cast<float>(cell.weight * std::exp(-0.5 * m2));
           }
         }
       }

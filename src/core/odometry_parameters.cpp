@@ -65,6 +65,7 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   }
   atLeast(s, "ndt_min_points", m.ndt.min_points, 3);
   positive(s, "ndt_eigen_ratio", m.ndt.eigen_ratio);
+  nonNegative(s, "ndt_point_sigma", m.ndt.point_sigma);
   positive(s, "raster_resolution", m.raster_resolution);
 
   // Differential Evolution.
