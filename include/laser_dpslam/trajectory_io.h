@@ -32,4 +32,8 @@ std::string formatTum(const std::vector<StampedPose>& poses);
 /// Reads a TUM file (planar part); throws std::runtime_error "FILE:LINE: what" on malformed lines.
 std::vector<StampedPose> readTum(const std::string& path);
 
+/// The pose of `poses` (sorted by stamp) at `stamp`: linear in x, y and along the shorter arc in θ between
+/// the two poses around it. False when `stamp` lies outside their time span (no extrapolation).
+bool interpolatePose(const std::vector<StampedPose>& poses, double stamp, Pose2D* pose);
+
 }  // namespace laser_dpslam

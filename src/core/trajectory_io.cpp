@@ -1,5 +1,6 @@
 #include "laser_dpslam/trajectory_io.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -105,6 +106,22 @@ std::vector<StampedPose> readTum(const std::string& path) {
     poses.push_back(p);
   }
   return poses;
+}
+
+bool interpolatePose(const std::vector<StampedPose>& poses, double stamp, Pose2D* pose) {
+  if (poses.empty() || !std::isfinite(stamp) || stamp < poses.front().stamp || stamp > poses.back().stamp) return false;
+  const auto hi = std::lower_bound(poses.begin(), poses.end(), stamp,
+                                   [](const StampedPose& p, double t) { return p.stamp < t; });
+  if (hi->stamp == stamp || hi == poses.begin()) {
+    *pose = hi->pose;
+    return true;
+  }
+  const StampedPose& a = *(hi - 1);
+  const StampedPose& b = *hi;
+  const double f = (stamp - a.stamp) / (b.stamp - a.stamp);
+  *pose = Pose2D(a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
+                 normalizeAngle(a.pose.theta + f * normalizeAngle(b.pose.theta - a.pose.theta)));
+  return true;
 }
 
 }  // namespace laser_dpslam

@@ -44,6 +44,12 @@ const char* kUsage =
     "                      [--memory-log FILE.csv]  (one line per scan: RSS, ancestry tree and map size)\n"
     "                      [--slam-log FILE.csv]    (one line per scan: the filter's best pose, spread, Neff;\n"
     "                                               not with --odometry-only)\n"
+    "                      [--motion-tum FILE.tum]  (the SLAM moves its particles by this trajectory's motion\n"
+    "                                               between scans, interpolated at their stamps, instead of\n"
+    "                                               the laser odometry's, with the odometry's covariance: wheel\n"
+    "                                               odometry, or a simulator's ground truth to measure the\n"
+    "                                               SLAM alone; scans outside its time span are not given to\n"
+    "                                               the SLAM)\n"
     "                      [--loops N]              (replay the bag N times, as rosbag play -l would: time\n"
     "                                               goes back at each loop and everything starts over)\n"
     "Outputs are written at the end, stats.json last; a failed run (e.g. a corrupted bag) writes none.\n"
@@ -62,6 +68,7 @@ struct Args {
   std::string match_log;
   std::string memory_log;
   std::string slam_log;
+  std::string motion_tum;
   int loops = 1;
 };
 
@@ -100,6 +107,7 @@ Args parseArgs(int argc, char** argv) {
     else if (f == "--match-log") a.match_log = next();
     else if (f == "--memory-log") a.memory_log = next();
     else if (f == "--slam-log") a.slam_log = next();
+    else if (f == "--motion-tum") a.motion_tum = next();
     else if (f == "--loops") {
       const double v = parseNumber(f, next());
       if (v < 1 || v > 1e6 || v != std::floor(v)) usageError("--loops expects a positive integer");
@@ -117,6 +125,7 @@ Args parseArgs(int argc, char** argv) {
   if (a.bag.empty()) usageError("--bag is required");
   if (a.out.empty()) usageError("--out is required");
   if (a.odometry_only && !a.slam_log.empty()) usageError("--slam-log needs the SLAM: drop --odometry-only");
+  if (a.odometry_only && !a.motion_tum.empty()) usageError("--motion-tum moves the SLAM: drop --odometry-only");
   return a;
 }
 
@@ -152,6 +161,21 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::cerr << "dpslam_offline: " << e.what() << "\n";
     return 2;
+  }
+  std::vector<StampedPose> motion;
+  if (!args.motion_tum.empty()) {
+    try {
+      motion = readTum(args.motion_tum);
+      for (std::size_t i = 1; i < motion.size(); ++i) {
+        if (!(motion[i].stamp > motion[i - 1].stamp)) {
+          throw std::runtime_error("'" + args.motion_tum + "': stamps must increase (pose " + std::to_string(i + 1) + ")");
+        }
+      }
+      if (motion.empty()) throw std::runtime_error("'" + args.motion_tum + "' holds no pose");
+    } catch (const std::exception& e) {
+      std::cerr << "dpslam_offline: --motion-tum: " << e.what() << "\n";
+      return 2;
+    }
   }
 
   if (::mkdir(args.out.c_str(), 0755) != 0 && errno != EEXIST) {
@@ -313,9 +337,13 @@ int main(int argc, char** argv) {
         odom_poses.push_back({scan.stamp, u.pose});
         odom_last_covariance = u.pose_covariance;
         last_stamp = scan.stamp;
-        if (slam) {
+        // The motion given to the SLAM: the laser odometry's, or --motion-tum's at this stamp.
+        Pose2D motion_pose = u.pose;
+        const bool have_motion = motion.empty() || interpolatePose(motion, scan.stamp, &motion_pose);
+        if (!have_motion) ++skipped["slam_outside_motion_tum"];
+        if (slam && have_motion) {
           slam_delta_cov += u.delta_covariance;
-          const Pose2D delta = slam_has_last && !u.reset ? between(slam_last_odom, u.pose) : Pose2D();
+          const Pose2D delta = slam_has_last && !u.reset ? between(slam_last_odom, motion_pose) : Pose2D();
           const auto s0 = std::chrono::steady_clock::now();
           last_slam = slam->process(scan.stamp, pre, mount, delta, slam_delta_cov);
           // Wall time: the SLAM scores particles on several threads.
@@ -330,7 +358,7 @@ int main(int argc, char** argv) {
             slam_log += line;
           }
           max_tree_nodes = std::max(max_tree_nodes, last_slam.tree_nodes);
-          slam_last_odom = u.pose;
+          slam_last_odom = motion_pose;
           slam_delta_cov.setZero();
           slam_has_last = true;
         }
