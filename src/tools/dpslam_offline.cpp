@@ -341,8 +341,8 @@ int main(int argc, char** argv) {
         Pose2D motion_pose = u.pose;
         const bool have_motion = motion.empty() || interpolatePose(motion, scan.stamp, &motion_pose);
         if (!have_motion) ++skipped["slam_outside_motion_tum"];
+        if (slam) slam_delta_cov += u.delta_covariance;  // a scan not given to the SLAM adds to the next delta's
         if (slam && have_motion) {
-          slam_delta_cov += u.delta_covariance;
           const Pose2D delta = slam_has_last && !u.reset ? between(slam_last_odom, motion_pose) : Pose2D();
           const auto s0 = std::chrono::steady_clock::now();
           last_slam = slam->process(scan.stamp, pre, mount, delta, slam_delta_cov);
