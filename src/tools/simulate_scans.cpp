@@ -2,7 +2,8 @@
 //
 //   simulate_scans --floorplan PLAN.yaml --path {loop,explore,WAYPOINTS.txt} --out DIR [--seed N] [--duration S]
 //                  [--rate HZ] [--laps N] [--start-time S] [--laser-x M] [--laser-y M] [--laser-yaw RAD]
-//                  [--dropout P] [--outliers P] [--no-noise] [--robot-radius M]
+//                  [--dropout P] [--outliers P] [--range-noise M]
+//                  [--range-noise-fraction F] [--no-noise] [--robot-radius M]
 //
 // Writes DIR/sim.bag (/scan, /tf_static, /ground_truth) and DIR/ground_truth.tum. `--path loop` and
 // `--path explore` are the waypoint files next to the plan: PLAN_DIR/<plan stem>_loop.txt and
@@ -55,6 +56,9 @@ const char* kUsage =
     "                       laser pose on base_link (default 0.1 0 0)\n"
     "  --dropout P          per-beam dropout probability -> NaN (default 0.01)\n"
     "  --outliers P         per-beam probability of a spurious short return (default 0)\n"
+    "  --range-noise M      range noise floor: sigma = max(M, F * range) (default 0.01)\n"
+    "  --range-noise-fraction F\n"
+    "                       range noise per metre of range (default 0.01, the datasheet's 1 %)\n"
     "  --no-noise           exact ranges: no range noise, dropouts or outliers\n"
     "  --robot-radius M     refuse paths closer than M to a wall (default 0.17, the Create's radius; 0: off)\n";
 
@@ -86,6 +90,8 @@ struct Options {
   Pose2D laser_mount{0.1, 0.0, 0.0};
   double dropout = 0.01;
   double outliers = 0.0;
+  double range_noise = 0.01;
+  double range_noise_fraction = 0.01;
   bool no_noise = false;
   double robot_radius = 0.17;
 };
@@ -137,6 +143,12 @@ Options parseArgs(int argc, char** argv) {
     } else if (flag == "--dropout") {
       o.dropout = parseDouble(flag, value);
       if (!(o.dropout >= 0.0 && o.dropout <= 1.0)) throw UsageError("--dropout must be in [0, 1]");
+    } else if (flag == "--range-noise") {
+      o.range_noise = parseDouble(flag, value);
+      if (!(o.range_noise >= 0.0)) throw UsageError("--range-noise must be >= 0");
+    } else if (flag == "--range-noise-fraction") {
+      o.range_noise_fraction = parseDouble(flag, value);
+      if (!(o.range_noise_fraction >= 0.0)) throw UsageError("--range-noise-fraction must be >= 0");
     } else if (flag == "--outliers") {
       o.outliers = parseDouble(flag, value);
       if (!(o.outliers >= 0.0 && o.outliers <= 1.0)) throw UsageError("--outliers must be in [0, 1]");
@@ -210,6 +222,8 @@ int run(const Options& o) {
   sensor.scan_rate = o.rate;
   sensor.dropout_probability = o.dropout;
   sensor.outlier_probability = o.outliers;
+  sensor.noise_min_stddev = o.range_noise;
+  sensor.noise_range_fraction = o.range_noise_fraction;
   if (o.no_noise) {
     sensor.noise_min_stddev = 0.0;
     sensor.noise_range_fraction = 0.0;
