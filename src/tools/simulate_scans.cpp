@@ -90,8 +90,8 @@ struct Options {
   Pose2D laser_mount{0.1, 0.0, 0.0};
   double dropout = 0.01;
   double outliers = 0.0;
-  double range_noise = 0.01;
-  double range_noise_fraction = 0.01;
+  double range_noise = ScanSimulatorConfig().noise_min_stddev;  // the datasheet's, as the simulator's defaults
+  double range_noise_fraction = ScanSimulatorConfig().noise_range_fraction;
   bool no_noise = false;
   double robot_radius = 0.17;
 };
