@@ -271,6 +271,57 @@ TEST(DpSlamMap, AddBeamWritesChordsAndTheHit) {
   EXPECT_EQ(map.check(), "");
 }
 
+// setSurfaceDepth: within the depth of a return, distances count multiplied by the beam's incidence, in
+// the writes and in both likelihoods; off (0) by default.
+TEST(DpSlamMap, SurfaceDepthCountsDistanceAlongTheNormal) {
+  AncestryTree tree;
+  DpSlamMap map(0.1, 4.0);
+  EXPECT_EQ(map.surfaceDepth(), 0.0);
+  map.setSurfaceDepth(0.25);
+  const int root = tree.createRoot();
+  LookupCache cache;
+  cache.begin(tree, {root});
+  MapBeam b;
+  b.ox = 0.05;
+  b.oy = 0.05;
+  b.range = 0.72;  // ends at x = 0.77; cells ending at or after 0.72 − 0.25 = 0.47 m count at half
+  b.incidence = 0.5;
+  map.addBeam(b, 20.0, 0, root, cache);
+  int n = 0;
+  EXPECT_NEAR(map.cellEntries(4, 0, &n)->distance, 0.1 + 0.4, 1e-6);         // t ∈ [0.35, 0.45]
+  EXPECT_NEAR(map.cellEntries(5, 0, &n)->distance, 0.5 * 0.1 + 0.4, 1e-6);   // t ∈ [0.45, 0.55]
+  EXPECT_NEAR(map.cellEntries(7, 0, &n)->distance, 0.5 * 0.07 + 0.4, 1e-6);  // the hit
+  EXPECT_EQ(map.cellEntries(7, 0, &n)->hits, 1.0f);
+  // A no-return beam is never projected.
+  b.oy = 1.05;
+  b.no_return = true;
+  map.addBeam(b, 20.0, 0, root, cache);
+  EXPECT_NEAR(map.cellEntries(6, 10, &n)->distance, 0.1 + 0.4, 1e-6);
+
+  // Scoring: cell 10 of row 3 a wall of density 20 /m, cell 11 opaque (as in ObservationModelValues).
+  // A return at 1.00 m with incidence 0.5 sees them as densities 10 /m and 1e4 /m.
+  DpSlamMap scored(0.1, 4.0);
+  for (int x = 0; x < 10; ++x) scored.observe(x, 3, root, tree, 1.0, false);
+  scored.observe(10, 3, root, tree, 0.05 - 0.4, true);
+  scored.observe(11, 3, root, tree, 5e-5 - 0.4, true);
+  BeamModelConfig m;
+  LookupCache c2;
+  c2.begin(tree, {root});
+  MapBeam r;
+  r.ox = 0.05;
+  r.oy = 0.35;
+  r.range = 1.0;
+  r.incidence = 0.5;
+  const double s2 = 2 * m.sigma * m.sigma;
+  const double p1 = 1 - std::exp(-1.0), p2 = std::exp(-1.0) * (1 - std::exp(-1e4 * 0.1));
+  const double off = scored.beamLogLikelihood(r, 20.0, 0, c2, m);  // depth 0: incidence ignored
+  scored.setSurfaceDepth(0.5);
+  EXPECT_NEAR(scored.beamLogLikelihood(r, 20.0, 0, c2, m), std::log((p1 + p2 * std::exp(-0.01 / s2)) / (p1 + p2)), 1e-6);
+  EXPECT_LT(scored.beamLogLikelihood(r, 20.0, 0, c2, m), off);  // more of the stops fall in cell 11 now
+  EXPECT_NEAR(scored.beamEndpointLogLikelihood(r, 0.25, 0, c2, m),
+              std::log((p1 + p2 * std::exp(-0.01 / s2)) / (p1 + p2)), 1e-6);
+}
+
 // Hand-computed beams through a known map (resolution 0.1 m, σ = 0.13 m, window 0.5 m, floor −1.15).
 TEST(DpSlamMap, ObservationModelValues) {
   AncestryTree tree;

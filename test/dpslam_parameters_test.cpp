@@ -33,6 +33,8 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.free_saturation_distance = 9;
   c.map_update_distance = 9;
   c.map_update_angle = 9;
+  c.surface_depth = 9;
+  c.surface_min_cos = 0.9;
   c.beam.sigma = 9;
   c.beam.window = 9;
   c.beam.log_floor = -9;
@@ -70,6 +72,8 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.free_saturation_distance, d.free_saturation_distance);
   EXPECT_EQ(c.map_update_distance, d.map_update_distance);
   EXPECT_EQ(c.map_update_angle, d.map_update_angle);
+  EXPECT_EQ(c.surface_depth, d.surface_depth);
+  EXPECT_EQ(c.surface_min_cos, d.surface_min_cos);
   EXPECT_EQ(c.beam.sigma, d.beam.sigma);
   EXPECT_EQ(c.beam.window, d.beam.window);
   EXPECT_EQ(c.beam.log_floor, d.beam.log_floor);
@@ -107,5 +111,8 @@ TEST(DpSlamParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("map_resolution: -0.05").find("map_resolution"), std::string::npos);
   EXPECT_NE(message("trace_max_range: 0.01").find("trace_max_range"), std::string::npos);
   EXPECT_NE(message("threads: 0").find("threads"), std::string::npos);
+  EXPECT_NE(message("surface_depth: -1").find("surface_depth"), std::string::npos);
+  EXPECT_NE(message("surface_min_cos: 0").find("surface_min_cos"), std::string::npos);
+  EXPECT_NE(message("surface_min_cos: 1.5").find("surface_min_cos"), std::string::npos);
   EXPECT_EQ(message("particles: 5"), "no error");
 }

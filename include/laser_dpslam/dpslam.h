@@ -13,6 +13,7 @@
 
 #include "laser_dpslam/ancestry_tree.h"
 #include "laser_dpslam/dpslam_map.h"
+#include "laser_dpslam/surface_incidence.h"
 #include "laser_dpslam/laser_mount.h"
 #include "laser_dpslam/occupancy_export.h"
 #include "laser_dpslam/particle_filter.h"
@@ -55,6 +56,10 @@ struct DpSlamConfig {
   double free_saturation_distance = 1.0;  ///< m; free cells seen without a hit over this distance are not rewritten (0 = off)
   double map_update_distance = 0.0;  ///< m travelled since the last map update before the next ...
   double map_update_angle = 0.0;     ///< rad turned since the last map update (0 and 0 = every filter update)
+  /// m; within this distance of a return (along its beam) distance through a cell is measured along the
+  /// normal of the surface hit, in writes and scores alike (DpSlamMap::setSurfaceDepth; 0 = off)
+  double surface_depth = 0.5;
+  double surface_min_cos = 0.35;  ///< lower bound of that projection (|cos| of the incidence; grazing fits are unreliable)
   // --- Observation model ---
   BeamModelConfig beam;         ///< sigma, window, log floor, unknown mean free path
   int score_beam_step = 4;      ///< every k-th beam is scored (tempering and speed)
@@ -119,6 +124,7 @@ class DpSlam {
     double dx, dy;  ///< unit direction in the base frame
     double range;   ///< m
     bool no_return;
+    double incidence;  ///< |cos| to the surface normal at the return (1: no return / no fit)
   };
   void makeBeams(const PreprocessedScan& scan, const LaserMount& mount);
   MapBeam toMap(const Pose2D& pose, const BaseBeam& b) const;

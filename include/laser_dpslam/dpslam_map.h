@@ -77,6 +77,7 @@ struct MapBeam {
   double dx = 1.0, dy = 0.0;  ///< unit direction
   double range = 0.0;         ///< m, measured range (for a no-return beam: the tracing cap)
   bool no_return = false;     ///< free space up to `range`, nothing hit
+  double incidence = 1.0;     ///< |cos| of the angle to the normal of the surface hit (see setSurfaceDepth)
 };
 
 class DpSlamMap;
@@ -125,6 +126,14 @@ class DpSlamMap : public AncestryHooks {
 
   void clear();
   double resolution() const { return resolution_; }
+  /// Within `depth` m (along the beam) of a return, a beam's distance through a cell counts multiplied by
+  /// the beam's `incidence`, i.e. as depth along the normal of the surface it ends on, in the writes and in
+  /// both likelihoods alike. A cell holds stops per metre of *normal* depth, whatever the angle the beams
+  /// came from: without it, the stops that range noise spreads in front of a surface (written mostly by
+  /// head-on beams, one cell of chord each) stop oblique beams early, which travel 1/cos as far through
+  /// them, and the filter prefers poses behind the truth (maps too short, README "Benchmarks"). 0 = off.
+  void setSurfaceDepth(double depth) { surface_depth_ = depth; }
+  double surfaceDepth() const { return surface_depth_; }
   int cellIndex(double v) const { return static_cast<int>(std::floor(v / resolution_)); }
 
   // --- Raw access ---
@@ -240,6 +249,7 @@ class DpSlamMap : public AncestryHooks {
 
   double resolution_;
   double prior_distance_;  ///< m
+  double surface_depth_ = 0.0;  ///< m, see setSurfaceDepth
   std::vector<std::unique_ptr<Tile>> tiles_;
   std::vector<std::int32_t> directory_;  ///< tile IDs over [tx0, tx0 + ntx) × [ty0, ty0 + nty)
   int tx0_ = 0, ty0_ = 0, ntx_ = 0, nty_ = 0;

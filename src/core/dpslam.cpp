@@ -48,6 +48,8 @@ void DpSlamConfig::validate() const {
   require(entry_prior_cells > 0.0, "entry_prior_cells must be > 0");
   require(update_beam_step >= 1 && score_beam_step >= 1, "beam steps must be >= 1");
   require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
+  require(surface_depth >= 0.0, "surface_depth must be >= 0");
+  require(surface_min_cos > 0.0 && surface_min_cos <= 1.0, "surface_min_cos must be in (0, 1]");
   require(map_update_distance >= 0.0 && map_update_angle >= 0.0, "map update thresholds must be >= 0");
   require(beam.sigma > 0.0, "beam_sigma must be > 0");
   require(likelihood_weight > 0.0 && likelihood_weight <= 1.0, "likelihood_weight must be in (0, 1]");
@@ -62,6 +64,7 @@ void DpSlamConfig::validate() const {
 DpSlam::DpSlam(const DpSlamConfig& config)
     : config_(config), rng_(config.seed), map_(config.map_resolution, config.entry_prior_cells) {
   config_.validate();
+  map_.setSurfaceDepth(config_.surface_depth);
   RevisitDetectorConfig rc;
   rc.radius = config_.revisit_radius;
   rc.min_travel = config_.revisit_min_travel;
@@ -96,6 +99,12 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
   const double no_return_range = std::min(config_.no_return_range, scan.range_max > 0.0 ? scan.range_max : config_.no_return_range);
   std::vector<BaseBeam> all;
   all.reserve(scan.points.size() + scan.no_return_angles.size());
+  std::vector<double> incidence;
+  if (config_.surface_depth > 0.0) {
+    SurfaceIncidenceConfig ic;
+    ic.min_cos = config_.surface_min_cos;
+    incidence = surfaceIncidence(scan, ic);
+  }
   // Returns and no-returns in beam-angle order, so that "every k-th beam" spreads over the whole scan.
   std::size_t i = 0, j = 0;
   while (i < scan.points.size() || j < scan.no_return_angles.size()) {
@@ -104,8 +113,9 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
     const double a = take_return ? scan.angles[i] : scan.no_return_angles[j];
     const Eigen::Vector2d d = mount.A * Eigen::Vector2d(std::cos(a), std::sin(a));
     const double n = d.norm();
-    BaseBeam b{d.x() / n, d.y() / n, 0.0, !take_return};
+    BaseBeam b{d.x() / n, d.y() / n, 0.0, !take_return, 1.0};
     if (take_return) {
+      if (!incidence.empty()) b.incidence = incidence[i];
       b.range = scan.ranges[i++];
     } else {
       b.range = no_return_range;
@@ -134,6 +144,7 @@ MapBeam DpSlam::toMap(const Pose2D& pose, const BaseBeam& b) const {
   m.dy = s * b.dx + c * b.dy;
   m.range = b.range;
   m.no_return = b.no_return;
+  m.incidence = b.incidence;
   return m;
 }
 

@@ -472,6 +472,8 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   const float saturation = free_saturation > 0.0 ? static_cast<float>(free_saturation) : std::numeric_limits<float>::infinity();
   const bool hit = !b.no_return && b.range <= max_range;
   const double length = std::min(b.range, max_range);
+  // Near the surface hit, distance counts along its normal (setSurfaceDepth).
+  const double surface_from = hit && surface_depth_ > 0.0 ? length - surface_depth_ : length + 1.0;
   Cursor cur;
   traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, length, resolution_, [&](int ix, int iy, double t0, double t1) {
     const bool end = hit && t1 >= length;
@@ -484,7 +486,8 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
         if (v.hits == 0.0f && v.distance >= saturation) return true;
       }
     }
-    out.push_back({ix, iy, static_cast<float>(t1 - t0), end ? 1.0f : 0.0f});
+    const double d = t1 >= surface_from ? (t1 - t0) * b.incidence : t1 - t0;
+    out.push_back({ix, iy, static_cast<float>(d), end ? 1.0f : 0.0f});
     return true;
   });
 }
@@ -539,6 +542,7 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
   const double window_start = z - m.window;
   const double inv_2s2 = 0.5 / (m.sigma * m.sigma);
   const double mu_unknown = 1.0 / m.unknown_mean_free_path;
+  const double surface = no_return ? 0.0 : surface_depth_;  // setSurfaceDepth: |t - z| < this counts along the normal
   double tau = 0.0, reach = 1.0, eval = 0.0;
   bool in_window = false;
   Cursor cur;
@@ -553,7 +557,8 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
       }
     }
     if (mu == 0.0) return true;
-    const double d = t1 - t0;
+    double d = t1 - t0;
+    if (std::abs(0.5 * (t0 + t1) - z) < surface) d *= b.incidence;
     if (t1 < window_start) {
       tau += mu * d;
       return true;
@@ -594,7 +599,9 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                  }
                }
                if (mu == 0.0) return true;
-               const double pass = std::exp(-mu * (t1 - t0));
+               double d = t1 - t0;
+               if (std::abs(0.5 * (t0 + t1) - z) < surface_depth_) d *= b.incidence;  // setSurfaceDepth
+               const double pass = std::exp(-mu * d);
                const double stop = reach * (1.0 - pass);
                reach *= pass;
                const double e = 0.5 * (t0 + t1) - z;

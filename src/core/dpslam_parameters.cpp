@@ -58,6 +58,10 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   positive(s, "entry_prior_cells", c.entry_prior_cells);
   atLeast(s, "update_beam_step", c.update_beam_step, 1);
   nonNegative(s, "free_saturation_distance", c.free_saturation_distance);
+  nonNegative(s, "surface_depth", c.surface_depth);
+  if (s.get("surface_min_cos", c.surface_min_cos)) {
+    require(c.surface_min_cos > 0.0 && c.surface_min_cos <= 1.0, "surface_min_cos", c.surface_min_cos, "must be in (0, 1]");
+  }
   nonNegative(s, "map_update_distance", c.map_update_distance);
   nonNegative(s, "map_update_angle", c.map_update_angle);
 
