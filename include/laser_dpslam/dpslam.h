@@ -13,13 +13,13 @@
 
 #include "laser_dpslam/ancestry_tree.h"
 #include "laser_dpslam/dpslam_map.h"
-#include "laser_dpslam/surface_incidence.h"
 #include "laser_dpslam/laser_mount.h"
 #include "laser_dpslam/occupancy_export.h"
 #include "laser_dpslam/particle_filter.h"
 #include "laser_dpslam/pose2d.h"
 #include "laser_dpslam/revisit_detector.h"
 #include "laser_dpslam/scan_preprocessor.h"
+#include "laser_dpslam/surface_incidence.h"
 #include "laser_dpslam/trajectory_io.h"
 
 namespace laser_dpslam {
