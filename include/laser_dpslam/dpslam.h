@@ -59,7 +59,7 @@ struct DpSlamConfig {
   /// m; within this distance of a return (along its beam) distance through a cell is measured along the
   /// normal of the surface hit, in writes and scores alike (DpSlamMap::setSurfaceDepth; 0 = off)
   double surface_depth = 0.5;
-  double surface_min_cos = 0.35;  ///< lower bound of that projection (|cos| of the incidence; grazing fits are unreliable)
+  double surface_min_cos = SurfaceIncidenceConfig().min_cos;  ///< lower bound of that projection (|cos| of the incidence; grazing fits are unreliable)
   // --- Observation model ---
   BeamModelConfig beam;         ///< sigma, window, log floor, unknown mean free path
   int score_beam_step = 4;      ///< every k-th beam is scored (tempering and speed)

@@ -19,8 +19,8 @@ std::vector<double> surfaceIncidence(const PreprocessedScan& scan, const Surface
     int count = 0;
     for (std::size_t j = lo; j <= hi; ++j) {
       if (std::abs(scan.beams[j] - scan.beams[i]) > config.half_window) continue;
-      if ((scan.points[j] - p).squaredNorm() > gap2) continue;
       const Eigen::Vector2d q = scan.points[j] - p;  // relative to p: better conditioned
+      if (q.squaredNorm() > gap2) continue;
       sum += q;
       sum2 += q * q.transpose();
       ++count;
