@@ -395,3 +395,41 @@ TEST(DpSlamMap, ObservationModelValues) {
   EXPECT_NEAR(map.beamEndpointLogLikelihood(beam(1.0), 0.5, 0, cache, m),
               map.beamLogLikelihood(beam(1.0), 20.0, 0, cache, m), 1e-9);
 }
+
+// The edge of what a range-limited laser has mapped pulls the filter back (DpSlamConfig::score_range_margin):
+// a side wall written from A (a laser with range_max 5.6 m) is known only up to x ≈ 5.51 m; from B, 0.2 m
+// further, a return just past that edge scores better the further back B is assumed, because the stop it
+// needs lies on cells only a pose behind has seen. Scored as free space up to a range short of the edge
+// (max_range 5.3 m), every pose is equal.
+TEST(DpSlamMap, ReturnsPastTheMappedEdgeFavourPosesBehindUnlessCutShort) {
+  AncestryTree tree;
+  DpSlamMap map(0.05, 4.0);
+  const int root = tree.createRoot();
+  LookupCache cache;
+  cache.begin(tree, {root});
+  const double range_max = 5.6, wall_y = 1.01;
+  for (double a = 0.05; a < 1.6; a += 0.001) {
+    MapBeam w;
+    w.dx = std::cos(a);
+    w.dy = std::sin(a);
+    w.range = wall_y / w.dy;
+    if (w.range > range_max) {
+      w.range = range_max;
+      w.no_return = true;
+    }
+    map.addBeam(w, 20.0, 0, root, cache);
+  }
+  auto score = [&](double x, double max_range) {
+    MapBeam b;
+    b.ox = x;
+    const double ex = 5.53, dx = ex - 0.2;  // the return seen from B = (0.2, 0) at (5.53, 1.01)
+    b.range = std::hypot(dx, wall_y);
+    b.dx = dx / b.range;
+    b.dy = wall_y / b.range;
+    return map.beamLogLikelihood(b, max_range, 0, cache, BeamModelConfig());
+  };
+  EXPECT_GT(score(0.15, 20.0), score(0.2, 20.0) + 0.1);
+  EXPECT_GT(score(0.1, 20.0), score(0.15, 20.0));
+  EXPECT_NEAR(score(0.15, 5.3), score(0.2, 5.3), 1e-9);
+  EXPECT_NEAR(score(0.1, 5.3), score(0.2, 5.3), 1e-9);
+}

@@ -35,6 +35,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.map_update_angle = 9;
   c.surface_depth = 9;
   c.surface_min_cos = 0.9;
+  c.score_range_margin = 9;
   c.beam.sigma = 9;
   c.beam.window = 9;
   c.beam.log_floor = -9;
@@ -74,6 +75,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.map_update_angle, d.map_update_angle);
   EXPECT_EQ(c.surface_depth, d.surface_depth);
   EXPECT_EQ(c.surface_min_cos, d.surface_min_cos);
+  EXPECT_EQ(c.score_range_margin, d.score_range_margin);
   EXPECT_EQ(c.beam.sigma, d.beam.sigma);
   EXPECT_EQ(c.beam.window, d.beam.window);
   EXPECT_EQ(c.beam.log_floor, d.beam.log_floor);
@@ -113,6 +115,7 @@ TEST(DpSlamParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("threads: 0").find("threads"), std::string::npos);
   EXPECT_NE(message("surface_depth: -1").find("surface_depth"), std::string::npos);
   EXPECT_NE(message("surface_min_cos: 0").find("surface_min_cos"), std::string::npos);
+  EXPECT_NE(message("score_range_margin: -0.1").find("score_range_margin"), std::string::npos);
   EXPECT_NE(message("surface_min_cos: 1.5").find("surface_min_cos"), std::string::npos);
   EXPECT_EQ(message("particles: 5"), "no error");
 }

@@ -330,3 +330,15 @@ TEST(DpSlam, InvalidConfigurationsAreRejected) {
   c.revisit_radius = 0.0;
   EXPECT_THROW(DpSlam{c}, std::invalid_argument);
 }
+
+TEST(DpSlam, ScoreRangeMarginCutsTheScoredRangeOfShortRangeLasers) {
+  DpSlamConfig c;
+  EXPECT_EQ(c.scoreRange(5.6), c.trace_max_range);  // off by default
+  c.score_range_margin = 0.3;
+  EXPECT_NEAR(c.scoreRange(5.6), 5.3, 1e-12);
+  EXPECT_EQ(c.scoreRange(81.9), c.trace_max_range);  // a long-range laser: traced to trace_max_range as before
+  EXPECT_EQ(c.scoreRange(0.0), c.trace_max_range);   // range_max unknown
+  EXPECT_EQ(c.scoreRange(0.5), c.trace_max_range);   // range_max not above twice the margin: not cut
+  c.score_range_margin = -0.1;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}

@@ -61,6 +61,13 @@ struct DpSlamConfig {
   double surface_depth = 0.5;
   double surface_min_cos = SurfaceIncidenceConfig().min_cos;  ///< lower bound of that projection (|cos| of the incidence; grazing fits are unreliable)
   // --- Observation model ---
+  /// m; returns within this of the scan's range_max are scored as free space up to range_max − this: the
+  /// walls around them were written from poses behind, whose range ended short of them, and a stop wanted
+  /// on cells only a pose behind has seen pulls the filter back (maps too short). 0 = off; applies to scans
+  /// whose range_max exceeds twice this.
+  double score_range_margin = 0.0;
+  /// m; how far beams of a scan with this range_max (0 = unknown) are traced and scored as returns.
+  double scoreRange(double scan_range_max) const;
   BeamModelConfig beam;         ///< sigma, window, log floor, unknown mean free path
   int score_beam_step = 4;      ///< every k-th beam is scored (tempering and speed)
   double likelihood_weight = 0.5;  ///< exponent of a scan's likelihood in the weights (tempering, 0–1]
@@ -162,6 +169,7 @@ class DpSlam {
   bool force_map_update_ = false;
 
   Eigen::Vector2d beam_origin_ = Eigen::Vector2d::Zero();  ///< laser position in the base frame
+  double score_range_ = 20.0;  ///< m, DpSlamConfig::scoreRange of the current scan
   std::vector<BaseBeam> score_beams_, update_beams_;
   RevisitDetector revisit_;      ///< on the best particle's path: exploring or revisiting
   bool last_revisit_ = false;

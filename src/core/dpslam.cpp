@@ -49,6 +49,7 @@ void DpSlamConfig::validate() const {
   require(update_beam_step >= 1 && score_beam_step >= 1, "beam steps must be >= 1");
   require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
   require(surface_depth >= 0.0, "surface_depth must be >= 0");
+  require(score_range_margin >= 0.0, "score_range_margin must be >= 0");
   require(surface_min_cos > 0.0 && surface_min_cos <= 1.0, "surface_min_cos must be in (0, 1]");
   require(map_update_distance >= 0.0 && map_update_angle >= 0.0, "map update thresholds must be >= 0");
   require(beam.sigma > 0.0, "beam_sigma must be > 0");
@@ -59,6 +60,12 @@ void DpSlamConfig::validate() const {
   require(min_points >= 1, "slam_min_points must be >= 1");
   require(occupancy_stop_length > 0.0, "occupancy_stop_length must be > 0");
   require(threads >= 1, "threads must be >= 1");
+}
+
+double DpSlamConfig::scoreRange(double scan_range_max) const {
+  if (score_range_margin > 0.0 && scan_range_max > 2.0 * score_range_margin)
+    return std::min(trace_max_range, scan_range_max - score_range_margin);
+  return trace_max_range;
 }
 
 DpSlam::DpSlam(const DpSlamConfig& config)
@@ -96,6 +103,7 @@ void DpSlam::reset() {
 
 void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
   beam_origin_ = mount.t;
+  score_range_ = config_.scoreRange(scan.range_max);
   const double no_return_range = std::min(config_.no_return_range, scan.range_max > 0.0 ? scan.range_max : config_.no_return_range);
   std::vector<BaseBeam> all;
   all.reserve(scan.points.size() + scan.no_return_angles.size());
@@ -151,7 +159,7 @@ MapBeam DpSlam::toMap(const Pose2D& pose, const BaseBeam& b) const {
 double DpSlam::score(const Pose2D& pose, int slot, LookupCache& cache) const {
   double sum = 0.0;
   for (const BaseBeam& b : score_beams_) {
-    sum += map_.beamLogLikelihood(toMap(pose, b), config_.trace_max_range, slot, cache, config_.beam);
+    sum += map_.beamLogLikelihood(toMap(pose, b), score_range_, slot, cache, config_.beam);
   }
   return sum;
 }
@@ -159,7 +167,7 @@ double DpSlam::score(const Pose2D& pose, int slot, LookupCache& cache) const {
 double DpSlam::cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const {
   double sum = 0.0;
   for (const BaseBeam& b : score_beams_) {
-    if (b.no_return || b.range >= config_.trace_max_range) continue;
+    if (b.no_return || b.range >= score_range_) continue;
     sum += map_.beamEndpointLogLikelihood(toMap(pose, b), config_.cull_window, slot, cache, config_.beam);
   }
   return sum;

@@ -59,6 +59,7 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   atLeast(s, "update_beam_step", c.update_beam_step, 1);
   nonNegative(s, "free_saturation_distance", c.free_saturation_distance);
   nonNegative(s, "surface_depth", c.surface_depth);
+  nonNegative(s, "score_range_margin", c.score_range_margin);
   if (s.get("surface_min_cos", c.surface_min_cos)) {
     require(c.surface_min_cos > 0.0 && c.surface_min_cos <= 1.0, "surface_min_cos", c.surface_min_cos, "must be in (0, 1]");
   }
