@@ -49,8 +49,8 @@ void DpSlamConfig::validate() const {
   require(update_beam_step >= 1 && score_beam_step >= 1, "beam steps must be >= 1");
   require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
   require(surface_depth >= 0.0, "surface_depth must be >= 0");
-  require(score_range_margin >= 0.0, "score_range_margin must be >= 0");
   require(surface_min_cos > 0.0 && surface_min_cos <= 1.0, "surface_min_cos must be in (0, 1]");
+  require(score_range_margin >= 0.0, "score_range_margin must be >= 0");
   require(map_update_distance >= 0.0 && map_update_angle >= 0.0, "map update thresholds must be >= 0");
   require(beam.sigma > 0.0, "beam_sigma must be > 0");
   require(likelihood_weight > 0.0 && likelihood_weight <= 1.0, "likelihood_weight must be in (0, 1]");

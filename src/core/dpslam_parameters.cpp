@@ -59,7 +59,6 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   atLeast(s, "update_beam_step", c.update_beam_step, 1);
   nonNegative(s, "free_saturation_distance", c.free_saturation_distance);
   nonNegative(s, "surface_depth", c.surface_depth);
-  nonNegative(s, "score_range_margin", c.score_range_margin);
   if (s.get("surface_min_cos", c.surface_min_cos)) {
     require(c.surface_min_cos > 0.0 && c.surface_min_cos <= 1.0, "surface_min_cos", c.surface_min_cos, "must be in (0, 1]");
   }
@@ -72,6 +71,7 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   if (s.get("beam_log_floor", c.beam.log_floor)) require(c.beam.log_floor < 0.0, "beam_log_floor", c.beam.log_floor, "must be < 0");
   positive(s, "unknown_mean_free_path", c.beam.unknown_mean_free_path);
   atLeast(s, "score_beam_step", c.score_beam_step, 1);
+  nonNegative(s, "score_range_margin", c.score_range_margin);
   if (s.get("likelihood_weight", c.likelihood_weight)) {
     require(c.likelihood_weight > 0.0 && c.likelihood_weight <= 1.0, "likelihood_weight", c.likelihood_weight, "must be in (0, 1]");
   }
