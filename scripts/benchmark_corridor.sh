@@ -21,7 +21,8 @@ while (($#)); do
     *) echo "unknown argument: $1" >&2; exit 2 ;;
   esac
 done
-OUT="$REPO/out/benchmark_corridor/$(basename "$WAYPOINTS" .txt)"
+# Bags are reused per plan, path and seed.
+OUT="$REPO/out/benchmark_corridor/$(basename "$PLAN" .yaml)-$(basename "$WAYPOINTS" .txt)"
 mkdir -p "$OUT"
 
 # Length error (%) of the leg between waypoints 2 and 3 (0.5 m inside each end) of an estimate (TUM).
