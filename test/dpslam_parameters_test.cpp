@@ -35,6 +35,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.map_update_angle = 9;
   c.surface_depth = 9;
   c.surface_min_cos = 0.9;
+  c.cell_normal_min_cos = 0.9;
   c.score_range_margin = 9;
   c.beam.sigma = 9;
   c.beam.window = 9;
@@ -75,6 +76,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.map_update_angle, d.map_update_angle);
   EXPECT_EQ(c.surface_depth, d.surface_depth);
   EXPECT_EQ(c.surface_min_cos, d.surface_min_cos);
+  EXPECT_EQ(c.cell_normal_min_cos, d.cell_normal_min_cos);
   EXPECT_EQ(c.score_range_margin, d.score_range_margin);
   EXPECT_EQ(c.beam.sigma, d.beam.sigma);
   EXPECT_EQ(c.beam.window, d.beam.window);
@@ -117,5 +119,8 @@ TEST(DpSlamParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("surface_min_cos: 0").find("surface_min_cos"), std::string::npos);
   EXPECT_NE(message("score_range_margin: -0.1").find("score_range_margin"), std::string::npos);
   EXPECT_NE(message("surface_min_cos: 1.5").find("surface_min_cos"), std::string::npos);
+  EXPECT_NE(message("cell_normal_min_cos: 1.5").find("cell_normal_min_cos"), std::string::npos);
+  EXPECT_NE(message("cell_normal_min_cos: -0.1").find("cell_normal_min_cos"), std::string::npos);
+  EXPECT_EQ(message("cell_normal_min_cos: 0"), "no error");
   EXPECT_EQ(message("particles: 5"), "no error");
 }

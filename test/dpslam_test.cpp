@@ -329,6 +329,47 @@ TEST(DpSlam, InvalidConfigurationsAreRejected) {
   c = DpSlamConfig();
   c.revisit_radius = 0.0;
   EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c = DpSlamConfig();
+  c.cell_normal_min_cos = 1.5;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+}
+
+// cell_normal_min_cos: the scan's fitted normals reach the map's cells (none are stored when it is off),
+// the result does not depend on the thread count, and the simulated loop still closes.
+TEST(DpSlam, CellNormalsReachTheMapAndKeepTheLoopClosed) {
+  auto normals = [](const DpSlam& slam) {
+    int x0, y0, x1, y1, count = 0;
+    if (!slam.map().bounds(&x0, &y0, &x1, &y1)) return 0;
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) count += slam.map().cellNormal(x, y) != 0;
+    }
+    return count;
+  };
+  DpSlamConfig off, on;
+  off.cell_normal_min_cos = 0.0;
+  on.cell_normal_min_cos = 0.1;
+  DpSlam a(off), b(on);
+  runSlam(off, 100, &a);
+  runSlam(on, 100, &b);
+  EXPECT_EQ(normals(a), 0);
+  EXPECT_GT(normals(b), 200);  // the room's walls seen in 10 s
+  DpSlamConfig one = on, two = on;
+  one.threads = 1;
+  two.threads = 2;
+  expectIdentical(runFull(one, 120), runFull(two, 120), "cell normals, 1 vs 2 threads");
+  // The whole two-lap loop, as ClosesASimulatedLoop... does with the defaults.
+  const SimRun& run = loopRun();
+  DpSlam slam(on);
+  const std::vector<StampedPose> traj = runSlam(on, run.scans.size(), &slam);
+  const Pose2D start = run.truth.front().pose;
+  double max_err = 0.0;
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    const Pose2D t = between(start, run.truth[i].pose);
+    max_err = std::max(max_err, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
+  }
+  const Pose2D end_truth = between(start, run.truth.back().pose), end = slam.bestPose();
+  EXPECT_LT(std::hypot(end.x - end_truth.x, end.y - end_truth.y), 0.05);
+  EXPECT_LT(max_err, 0.12);
 }
 
 TEST(DpSlam, ScoreRangeMarginCutsTheScoredRangeOfShortRangeLasers) {

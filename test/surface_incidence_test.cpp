@@ -41,6 +41,19 @@ TEST(SurfaceIncidence, FlatWallGivesTheCosineOfEachBeamToItsNormal) {
   EXPECT_NEAR(surfaceIncidence(g, c).back(), std::max(0.35, std::sin(0.2 + 0.01 * 39)), 1e-9);
 }
 
+TEST(SurfaceIncidence, FitsGiveTheNormalsToo) {
+  const PreprocessedScan s = scanOf(-0.6, 121, [](double a) { return 2.0 / std::cos(a); });  // wall x = 2
+  const SurfaceFits f = fitSurfaces(s, SurfaceIncidenceConfig());
+  ASSERT_EQ(f.normals.size(), s.points.size());
+  EXPECT_EQ(f.incidence, surfaceIncidence(s, SurfaceIncidenceConfig()));
+  for (const Eigen::Vector2d& n : f.normals) {
+    EXPECT_NEAR(std::abs(n.x()), 1.0, 1e-9);
+    EXPECT_NEAR(n.y(), 0.0, 1e-9);
+  }
+  PreprocessedScan lone = scanOf(0.0, 1, [](double) { return 1.0; });  // no fit: no normal
+  EXPECT_EQ(fitSurfaces(lone, SurfaceIncidenceConfig()).normals.at(0), Eigen::Vector2d::Zero());
+}
+
 TEST(SurfaceIncidence, NoFitWithoutThreeNearbyReturns) {
   // Alternate ranges 1 m and 3 m: no neighbour within max_gap in the window → 1 (no correction).
   int k = 0;

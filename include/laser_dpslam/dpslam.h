@@ -60,6 +60,9 @@ struct DpSlamConfig {
   /// normal of the surface hit, in writes and scores alike (DpSlamMap::setSurfaceDepth; 0 = off)
   double surface_depth = 0.5;
   double surface_min_cos = SurfaceIncidenceConfig().min_cos;  ///< lower bound of that projection (|cos| of the incidence; grazing fits are unreliable)
+  /// [0, 1]: a cell a beam stopped in keeps that surface's normal, and distance through it counts along that
+  /// normal for every beam crossing it, |cos| bounded below by this (DpSlamMap::setCellNormals; 0 = off)
+  double cell_normal_min_cos = 0.0;
   // --- Observation model ---
   /// m; returns within this of the scan's range_max are scored as free space up to range_max − this: the
   /// walls around them were written from poses behind, whose range ended short of them, and a stop wanted
@@ -132,6 +135,7 @@ class DpSlam {
     double range;   ///< m
     bool no_return;
     double incidence;  ///< |cos| to the surface normal at the return (1: no return / no fit)
+    double nx = 0.0, ny = 0.0;  ///< that normal in the base frame ((0, 0): no return / no fit)
   };
   void makeBeams(const PreprocessedScan& scan, const LaserMount& mount);
   MapBeam toMap(const Pose2D& pose, const BaseBeam& b) const;

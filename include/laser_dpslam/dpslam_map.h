@@ -78,6 +78,7 @@ struct MapBeam {
   double range = 0.0;         ///< m, measured range (for a no-return beam: the tracing cap)
   bool no_return = false;     ///< free space up to `range`, nothing hit
   double incidence = 1.0;     ///< |cos| of the angle to the normal of the surface hit (see setSurfaceDepth)
+  double nx = 0.0, ny = 0.0;  ///< unit normal of the surface hit (sign arbitrary); (0, 0) = unknown (setCellNormals)
 };
 
 class DpSlamMap;
@@ -134,6 +135,21 @@ class DpSlamMap : public AncestryHooks {
   /// them, and the filter prefers poses behind the truth (maps too short, README "Benchmarks"). 0 = off.
   void setSurfaceDepth(double depth) { surface_depth_ = depth; }
   double surfaceDepth() const { return surface_depth_; }
+  /// Cell normals. A cell in which a beam with a known surface normal (MapBeam::nx, ny) stopped remembers
+  /// that normal (the last one, to 0.7°; one per cell, shared by all particles: the local geometry hardly
+  /// differs between them). Then distance through the cell counts along its normal — times |cos| between
+  /// the beam and the normal, bounded below by `min_cos` — for every beam that crosses it, in the writes and
+  /// in both likelihoods alike, whether the beam ends there or passes by: the cell holds stops per metre of
+  /// normal depth. This is setSurfaceDepth for the beams that pass a surface instead of ending on it: the
+  /// range noise of a wall's writers leaves stops in the free cells in front of it, and a beam grazing along
+  /// the wall through them (towards a corner beyond it) was stopped there early, so that poses moved away
+  /// from the wall scored better (the end faces of niches pulled the filter behind, README "Benchmarks").
+  /// Cells without a normal keep the setSurfaceDepth rule. 0 = off.
+  void setCellNormals(double min_cos) { cell_normal_min_cos_ = min_cos; }
+  double cellNormals() const { return cell_normal_min_cos_; }
+  /// The quantised normal stored in cell (ix, iy): 0 = none, else k in 1..255 for the angle (k − ½)·π/255.
+  int cellNormal(int ix, int iy) const;
+  static int quantizeNormal(double nx, double ny);  ///< 0 for (0, 0)
   int cellIndex(double v) const { return static_cast<int>(std::floor(v / resolution_)); }
 
   // --- Raw access ---
@@ -176,6 +192,7 @@ class DpSlamMap : public AncestryHooks {
     std::int32_t ix, iy;
     float d;    ///< m of beam through the cell
     float hit;  ///< 1 for the cell where the beam stopped, else 0
+    std::uint8_t normal = 0;  ///< quantised normal the cell takes (0 = leave it), see setCellNormals
   };
   void planBeam(const MapBeam& beam, double max_range, int slot, LookupCache& cache, double free_saturation,
                 std::vector<CellWrite>& out) const;
@@ -208,7 +225,7 @@ class DpSlamMap : public AncestryHooks {
     std::uint32_t block = 0;
     std::uint16_t size = 0;
     std::uint8_t cls = 0xFF;  ///< size class of the block (capacity 1 << cls); 0xFF = none
-    std::uint8_t pad = 0;
+    std::uint8_t normal = 0;  ///< quantised surface normal, see setCellNormals (0 = none)
   };
   struct Tile {
     int tx = 0, ty = 0;
@@ -250,6 +267,9 @@ class DpSlamMap : public AncestryHooks {
   double resolution_;
   double prior_distance_;  ///< m
   double surface_depth_ = 0.0;  ///< m, see setSurfaceDepth
+  double cell_normal_min_cos_ = 0.0;  ///< see setCellNormals
+  /// Distance factor for a beam of direction (dx, dy) crossing a cell with quantised normal q (> 0).
+  double normalFactor(int q, double dx, double dy) const;
   std::vector<std::unique_ptr<Tile>> tiles_;
   std::vector<std::int32_t> directory_;  ///< tile IDs over [tx0, tx0 + ntx) × [ty0, ty0 + nty)
   int tx0_ = 0, ty0_ = 0, ntx_ = 0, nty_ = 0;

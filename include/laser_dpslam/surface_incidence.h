@@ -5,6 +5,8 @@
 
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "laser_dpslam/scan_preprocessor.h"
 
 namespace laser_dpslam {
@@ -20,5 +22,13 @@ struct SurfaceIncidenceConfig {
 /// max_gap m of it (the return included). 1 (head-on, no correction) when fewer than 3 returns qualify.
 /// Rotation-invariant, so it can be computed once per scan in the laser frame.
 std::vector<double> surfaceIncidence(const PreprocessedScan& scan, const SurfaceIncidenceConfig& config);
+
+/// surfaceIncidence and the fitted normals themselves: normals[i] is the unit normal of the line fitted at
+/// return i in the laser frame (sign arbitrary), (0, 0) where there is no fit (incidence 1).
+struct SurfaceFits {
+  std::vector<double> incidence;
+  std::vector<Eigen::Vector2d> normals;
+};
+SurfaceFits fitSurfaces(const PreprocessedScan& scan, const SurfaceIncidenceConfig& config);
 
 }  // namespace laser_dpslam

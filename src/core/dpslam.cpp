@@ -50,6 +50,7 @@ void DpSlamConfig::validate() const {
   require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
   require(surface_depth >= 0.0, "surface_depth must be >= 0");
   require(surface_min_cos > 0.0 && surface_min_cos <= 1.0, "surface_min_cos must be in (0, 1]");
+  require(cell_normal_min_cos >= 0.0 && cell_normal_min_cos <= 1.0, "cell_normal_min_cos must be in [0, 1]");
   require(score_range_margin >= 0.0, "score_range_margin must be >= 0");
   require(map_update_distance >= 0.0 && map_update_angle >= 0.0, "map update thresholds must be >= 0");
   require(beam.sigma > 0.0, "beam_sigma must be > 0");
@@ -72,6 +73,7 @@ DpSlam::DpSlam(const DpSlamConfig& config)
     : config_(config), rng_(config.seed), map_(config.map_resolution, config.entry_prior_cells) {
   config_.validate();
   map_.setSurfaceDepth(config_.surface_depth);
+  map_.setCellNormals(config_.cell_normal_min_cos);
   RevisitDetectorConfig rc;
   rc.radius = config_.revisit_radius;
   rc.min_travel = config_.revisit_min_travel;
@@ -107,11 +109,11 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
   const double no_return_range = std::min(config_.no_return_range, scan.range_max > 0.0 ? scan.range_max : config_.no_return_range);
   std::vector<BaseBeam> all;
   all.reserve(scan.points.size() + scan.no_return_angles.size());
-  std::vector<double> incidence;
-  if (config_.surface_depth > 0.0) {
+  SurfaceFits fits;
+  if (config_.surface_depth > 0.0 || config_.cell_normal_min_cos > 0.0) {
     SurfaceIncidenceConfig ic;
     ic.min_cos = config_.surface_min_cos;
-    incidence = surfaceIncidence(scan, ic);
+    fits = fitSurfaces(scan, ic);
   }
   // Returns and no-returns in beam-angle order, so that "every k-th beam" spreads over the whole scan.
   std::size_t i = 0, j = 0;
@@ -123,7 +125,12 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
     const double n = d.norm();
     BaseBeam b{d.x() / n, d.y() / n, 0.0, !take_return, 1.0};
     if (take_return) {
-      if (!incidence.empty()) b.incidence = incidence[i];
+      if (!fits.incidence.empty()) {
+        if (config_.surface_depth > 0.0) b.incidence = fits.incidence[i];
+        const Eigen::Vector2d nb = mount.A * fits.normals[i];
+        b.nx = nb.x();
+        b.ny = nb.y();
+      }
       b.range = scan.ranges[i++];
     } else {
       b.range = no_return_range;
@@ -153,6 +160,8 @@ MapBeam DpSlam::toMap(const Pose2D& pose, const BaseBeam& b) const {
   m.range = b.range;
   m.no_return = b.no_return;
   m.incidence = b.incidence;
+  m.nx = c * b.nx - s * b.ny;
+  m.ny = s * b.nx + c * b.ny;
   return m;
 }
 

@@ -1,5 +1,7 @@
 #include "laser_dpslam/dpslam_map.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -317,6 +319,23 @@ const MapEntry* DpSlamMap::lookup(int ix, int iy, const std::vector<int>& rank) 
 }
 
 namespace {
+/// Unit vectors of the 255 quantised normal angles (index 0 unused).
+struct NormalTable {
+  double c[256], s[256];
+  NormalTable() {
+    c[0] = s[0] = 0.0;
+    for (int k = 1; k < 256; ++k) {
+      const double a = (k - 0.5) * M_PI / 255.0;
+      c[k] = std::cos(a);
+      s[k] = std::sin(a);
+    }
+  }
+};
+const NormalTable& normalTable() {
+  static const NormalTable t;
+  return t;
+}
+
 constexpr std::uint32_t kUniform = 0x80000000u;  ///< row word flag: every slot sees entry (word & ~flag) − 1
 }  // namespace
 
@@ -439,6 +458,24 @@ const MapEntry* DpSlamMap::cachedLookup(int ix, int iy, int slot, LookupCache& c
   return j < 0 ? nullptr : &pool_->at(tiles_[t]->cells[cell].cls, tiles_[t]->cells[cell].block)[j];
 }
 
+int DpSlamMap::quantizeNormal(double nx, double ny) {
+  if (nx == 0.0 && ny == 0.0) return 0;
+  double a = std::atan2(ny, nx);  // a normal's sign does not matter: angle modulo π
+  if (a < 0.0) a += M_PI;
+  if (a >= M_PI) a -= M_PI;
+  return std::min(255, 1 + static_cast<int>(a * (255.0 / M_PI)));
+}
+
+int DpSlamMap::cellNormal(int ix, int iy) const {
+  const int t = tileId(ix, iy);
+  return t < 0 ? 0 : tiles_[t]->cells[cellInTile(ix, iy)].normal;
+}
+
+inline double DpSlamMap::normalFactor(int q, double dx, double dy) const {
+  const NormalTable& n = normalTable();
+  return std::max(cell_normal_min_cos_, std::abs(n.c[q] * dx + n.s[q] * dy));
+}
+
 // --- Updates ---------------------------------------------------------------------------------------
 namespace {
 struct Observation {
@@ -474,20 +511,33 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   const double length = std::min(b.range, max_range);
   // Near the surface hit, distance counts along its normal (setSurfaceDepth).
   const double surface_from = hit && surface_depth_ > 0.0 ? length - surface_depth_ : length + 1.0;
+  // setCellNormals: the cell the beam stops in takes the normal of the surface it hit.
+  const bool normals = cell_normal_min_cos_ > 0.0;
+  const int beam_normal = normals && hit ? quantizeNormal(b.nx, b.ny) : 0;
   Cursor cur;
   traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, length, resolution_, [&](int ix, int iy, double t0, double t1) {
     const bool end = hit && t1 >= length;
-    if (!end && seek(cur, ix, iy, cache)) {
+    int q = 0;  // the cell's normal, if it has statistics
+    if ((normals || !end) && seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
       const int vis = resolve(cur, cell, slot, cache);
       if (vis >= 0) {
         const Cell& c = cur.t->cells[cell];
         const MapEntry& v = pool_->at(c.cls, c.block)[vis];
-        if (v.hits == 0.0f && v.distance >= saturation) return true;
+        if (!end && v.hits == 0.0f && v.distance >= saturation) return true;
+        if (normals) q = c.normal;
       }
     }
-    const double d = t1 >= surface_from ? (t1 - t0) * b.incidence : t1 - t0;
-    out.push_back({ix, iy, static_cast<float>(d), end ? 1.0f : 0.0f});
+    if (end && !q) q = beam_normal;  // a new surface cell: the normal it is about to take
+    double f = 1.0;
+    if (q) {
+      f = normalFactor(q, b.dx, b.dy);
+    } else if (t1 >= surface_from) {
+      f = b.incidence;
+    }
+    CellWrite w{ix, iy, static_cast<float>((t1 - t0) * f), end ? 1.0f : 0.0f};
+    if (end) w.normal = static_cast<std::uint8_t>(beam_normal);
+    out.push_back(w);
     return true;
   });
 }
@@ -502,6 +552,7 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
     const int cell = cellInTile(w.ix, w.iy);
     const int vis = resolve(cur, cell, slot, cache);
     Cell& c = cur.t->cells[cell];
+    if (w.normal) c.normal = w.normal;
     MapEntry ne;
     ne.owner = node;
     if (vis >= 0) {
@@ -543,22 +594,29 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
   const double inv_2s2 = 0.5 / (m.sigma * m.sigma);
   const double mu_unknown = 1.0 / m.unknown_mean_free_path;
   const double surface = no_return ? 0.0 : surface_depth_;  // setSurfaceDepth: |t - z| < this counts along the normal
+  const bool normals = cell_normal_min_cos_ > 0.0;
   double tau = 0.0, reach = 1.0, eval = 0.0;
   bool in_window = false;
   Cursor cur;
   traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, t_end, resolution_, [&](int ix, int iy, double t0, double t1) {
     double mu = mu_unknown;
+    int q = 0;
     if (seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
       const int vis = resolve(cur, cell, slot, cache);
       if (vis >= 0) {
         const Cell& c = cur.t->cells[cell];
         mu = pool_->at(c.cls, c.block)[vis].density();
+        if (normals) q = c.normal;
       }
     }
     if (mu == 0.0) return true;
     double d = t1 - t0;
-    if (std::abs(0.5 * (t0 + t1) - z) < surface) d *= b.incidence;
+    if (q) {
+      d *= normalFactor(q, b.dx, b.dy);  // setCellNormals
+    } else if (std::abs(0.5 * (t0 + t1) - z) < surface) {
+      d *= b.incidence;
+    }
     if (t1 < window_start) {
       tau += mu * d;
       return true;
@@ -590,17 +648,23 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
   traceCells(b.ox, b.oy, b.dx, b.dy, std::max(0.0, z - half_window), z + half_window, resolution_,
              [&](int ix, int iy, double t0, double t1) {
                double mu = mu_unknown;
+               int q = 0;
                if (seek(cur, ix, iy, cache)) {
                  const int cell = cellInTile(ix, iy);
                  const int vis = resolve(cur, cell, slot, cache);
                  if (vis >= 0) {
                    const Cell& c = cur.t->cells[cell];
                    mu = pool_->at(c.cls, c.block)[vis].density();
+                   if (cell_normal_min_cos_ > 0.0) q = c.normal;
                  }
                }
                if (mu == 0.0) return true;
                double d = t1 - t0;
-               if (std::abs(0.5 * (t0 + t1) - z) < surface_depth_) d *= b.incidence;  // setSurfaceDepth
+               if (q) {
+                 d *= normalFactor(q, b.dx, b.dy);  // setCellNormals
+               } else if (std::abs(0.5 * (t0 + t1) - z) < surface_depth_) {
+                 d *= b.incidence;  // setSurfaceDepth
+               }
                const double pass = std::exp(-mu * d);
                const double stop = reach * (1.0 - pass);
                reach *= pass;

@@ -62,6 +62,10 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   if (s.get("surface_min_cos", c.surface_min_cos)) {
     require(c.surface_min_cos > 0.0 && c.surface_min_cos <= 1.0, "surface_min_cos", c.surface_min_cos, "must be in (0, 1]");
   }
+  if (s.get("cell_normal_min_cos", c.cell_normal_min_cos)) {
+    require(c.cell_normal_min_cos >= 0.0 && c.cell_normal_min_cos <= 1.0, "cell_normal_min_cos", c.cell_normal_min_cos,
+            "must be in [0, 1]");
+  }
   nonNegative(s, "map_update_distance", c.map_update_distance);
   nonNegative(s, "map_update_angle", c.map_update_angle);
 

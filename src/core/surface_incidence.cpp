@@ -6,8 +6,14 @@
 namespace laser_dpslam {
 
 std::vector<double> surfaceIncidence(const PreprocessedScan& scan, const SurfaceIncidenceConfig& config) {
+  return fitSurfaces(scan, config).incidence;
+}
+
+SurfaceFits fitSurfaces(const PreprocessedScan& scan, const SurfaceIncidenceConfig& config) {
   const std::size_t n = scan.points.size();
-  std::vector<double> out(n, 1.0);
+  SurfaceFits fits;
+  fits.incidence.assign(n, 1.0);
+  fits.normals.assign(n, Eigen::Vector2d::Zero());
   const double gap2 = config.max_gap * config.max_gap;
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d& p = scan.points[i];
@@ -32,9 +38,10 @@ std::vector<double> surfaceIncidence(const PreprocessedScan& scan, const Surface
     const double phi = 0.5 * std::atan2(2.0 * cov(0, 1), cov(0, 0) - cov(1, 1));
     const Eigen::Vector2d normal(-std::sin(phi), std::cos(phi));
     const Eigen::Vector2d dir(std::cos(scan.angles[i]), std::sin(scan.angles[i]));
-    out[i] = std::clamp(std::abs(normal.dot(dir)), config.min_cos, 1.0);
+    fits.incidence[i] = std::clamp(std::abs(normal.dot(dir)), config.min_cos, 1.0);
+    fits.normals[i] = normal;
   }
-  return out;
+  return fits;
 }
 
 }  // namespace laser_dpslam
