@@ -268,8 +268,9 @@ class DpSlamMap : public AncestryHooks {
   double prior_distance_;  ///< m
   double surface_depth_ = 0.0;  ///< m, see setSurfaceDepth
   double cell_normal_min_cos_ = 0.0;  ///< see setCellNormals
-  /// Distance factor for a beam of direction (dx, dy) crossing a cell with quantised normal q (> 0).
-  double normalFactor(int q, double dx, double dy) const;
+  /// What a chord of beam b through a cell counts for: along the cell's quantised normal q when it has one
+  /// (setCellNormals), else along the normal of the surface b ends on when `near_return` (setSurfaceDepth).
+  double chordFactor(int q, const MapBeam& b, bool near_return) const;
   std::vector<std::unique_ptr<Tile>> tiles_;
   std::vector<std::int32_t> directory_;  ///< tile IDs over [tx0, tx0 + ntx) × [ty0, ty0 + nty)
   int tx0_ = 0, ty0_ = 0, ntx_ = 0, nty_ = 0;

@@ -471,9 +471,12 @@ int DpSlamMap::cellNormal(int ix, int iy) const {
   return t < 0 ? 0 : tiles_[t]->cells[cellInTile(ix, iy)].normal;
 }
 
-inline double DpSlamMap::normalFactor(int q, double dx, double dy) const {
-  const NormalTable& n = normalTable();
-  return std::max(cell_normal_min_cos_, std::abs(n.c[q] * dx + n.s[q] * dy));
+inline double DpSlamMap::chordFactor(int q, const MapBeam& b, bool near_return) const {
+  if (q) {
+    const NormalTable& n = normalTable();
+    return std::max(cell_normal_min_cos_, std::abs(n.c[q] * b.dx + n.s[q] * b.dy));
+  }
+  return near_return ? b.incidence : 1.0;
 }
 
 // --- Updates ---------------------------------------------------------------------------------------
@@ -529,13 +532,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
       }
     }
     if (end && !q) q = beam_normal;  // a new surface cell: the normal it is about to take
-    double f = 1.0;
-    if (q) {
-      f = normalFactor(q, b.dx, b.dy);
-    } else if (t1 >= surface_from) {
-      f = b.incidence;
-    }
-    CellWrite w{ix, iy, static_cast<float>((t1 - t0) * f), end ? 1.0f : 0.0f};
+    CellWrite w{ix, iy, static_cast<float>((t1 - t0) * chordFactor(q, b, t1 >= surface_from)), end ? 1.0f : 0.0f};
     if (end) w.normal = static_cast<std::uint8_t>(beam_normal);
     out.push_back(w);
     return true;
@@ -611,12 +608,7 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
       }
     }
     if (mu == 0.0) return true;
-    double d = t1 - t0;
-    if (q) {
-      d *= normalFactor(q, b.dx, b.dy);  // setCellNormals
-    } else if (std::abs(0.5 * (t0 + t1) - z) < surface) {
-      d *= b.incidence;
-    }
+    double d = (t1 - t0) * chordFactor(q, b, std::abs(0.5 * (t0 + t1) - z) < surface);
     if (t1 < window_start) {
       tau += mu * d;
       return true;
@@ -659,12 +651,7 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                  }
                }
                if (mu == 0.0) return true;
-               double d = t1 - t0;
-               if (q) {
-                 d *= normalFactor(q, b.dx, b.dy);  // setCellNormals
-               } else if (std::abs(0.5 * (t0 + t1) - z) < surface_depth_) {
-                 d *= b.incidence;  // setSurfaceDepth
-               }
+               const double d = (t1 - t0) * chordFactor(q, b, std::abs(0.5 * (t0 + t1) - z) < surface_depth_);
                const double pass = std::exp(-mu * d);
                const double stop = reach * (1.0 - pass);
                reach *= pass;
