@@ -322,6 +322,12 @@ TEST(DpSlamMap, SurfaceDepthCountsDistanceAlongTheNormal) {
               std::log((p1 + p2 * std::exp(-0.01 / s2)) / (p1 + p2)), 1e-6);
 }
 
+// The normal a lineage sees in a cell (0 = none).
+int normalSeen(const DpSlamMap& map, int ix, int iy, int node, const AncestryTree& tree) {
+  const MapEntry* e = map.lookup(ix, iy, node, tree);
+  return e ? e->normal : 0;
+}
+
 // setCellNormals: the cell a beam stops in takes the beam's surface normal; afterwards every beam crossing
 // that cell counts its chord times |cos| to that normal (bounded below), in writes and in scores; off (0)
 // by default, and then nothing changes.
@@ -349,10 +355,10 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
   LookupCache c_on, c_off;
   build(on, c_on);
   build(off, c_off);
-  EXPECT_EQ(on.cellNormal(10, 0), DpSlamMap::quantizeNormal(1.0, 0.0));
-  EXPECT_EQ(on.cellNormal(11, 0), DpSlamMap::quantizeNormal(1.0, 0.0));
-  EXPECT_EQ(on.cellNormal(9, 0), 0);   // crossed, never stopped in
-  EXPECT_EQ(off.cellNormal(10, 0), 0);  // off: nothing stored
+  EXPECT_EQ(normalSeen(on, 10, 0, root, tree), DpSlamMap::quantizeNormal(1.0, 0.0));
+  EXPECT_EQ(normalSeen(on, 11, 0, root, tree), DpSlamMap::quantizeNormal(1.0, 0.0));
+  EXPECT_EQ(normalSeen(on, 9, 0, root, tree), 0);   // crossed, never stopped in
+  EXPECT_EQ(normalSeen(off, 10, 0, root, tree), 0);  // off: nothing stored
   int n = 0;
   // Head-on, |cos| ≈ 1: the same statistics, and the same score, either way (no normal in the free cells).
   EXPECT_NEAR(on.cellEntries(10, 0, &n)->distance, off.cellEntries(10, 0, &n)->distance, 1e-4);
@@ -387,8 +393,8 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
     on.addBeam(g, 20.0, 0, root, c_on);
     off.addBeam(g, 20.0, 0, root, c_off);
   }
-  EXPECT_EQ(on.cellNormal(10, 5), DpSlamMap::quantizeNormal(0.0, 1.0));
-  EXPECT_EQ(on.cellNormal(10, 0), DpSlamMap::quantizeNormal(1.0, 0.0));  // passing beams leave it as it was
+  EXPECT_EQ(normalSeen(on, 10, 5, root, tree), DpSlamMap::quantizeNormal(0.0, 1.0));
+  EXPECT_EQ(normalSeen(on, 10, 0, root, tree), DpSlamMap::quantizeNormal(1.0, 0.0));  // passing beams leave it as it was
   g.range = 1.5;
   const double ll_on = on.beamLogLikelihood(g, 20.0, 0, c_on, BeamModelConfig());
   const double ll_off = off.beamLogLikelihood(g, 20.0, 0, c_off, BeamModelConfig());
@@ -399,6 +405,65 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
 }
 
 // Hand-computed beams through a known map (resolution 0.1 m, σ = 0.13 m, window 0.5 m, floor −1.15).
+// Each lineage keeps the normals of its own history: two siblings that saw the same cell as different
+// surfaces score a beam grazing it each by its own normal, and their parent's view is untouched.
+TEST(DpSlamMap, CellNormalsBelongToTheLineageThatWroteThem) {
+  AncestryTree tree;
+  const int root = tree.createRoot();
+  DpSlamMap map(0.1, 4.0);
+  map.setCellNormals(0.1);
+  map.observe(10, 0, root, tree, 0.1, false);  // the root saw the cell, without a normal
+  const auto kids = tree.advance({root}, {0, 0}, 1, map);
+  LookupCache cache;
+  cache.begin(tree, kids);
+  MapBeam along_x;  // head-on from the west: ends in cell (10, 0) on a face with its normal along x
+  along_x.ox = 0.05;
+  along_x.oy = 0.05;
+  along_x.range = 1.0;
+  along_x.nx = 1.0;
+  MapBeam along_y = along_x;  // from the south: ends in the same cell on a face with its normal along y
+  along_y.ox = 1.05;
+  along_y.oy = -0.95;
+  along_y.dx = 0.0;
+  along_y.dy = 1.0;
+  along_y.nx = 0.0;
+  along_y.ny = 1.0;
+  for (int k = 0; k < 5; ++k) {
+    map.addBeam(along_x, 20.0, 0, kids[0], cache);
+    map.addBeam(along_y, 20.0, 1, kids[1], cache);
+  }
+  EXPECT_EQ(normalSeen(map, 10, 0, kids[0], tree), DpSlamMap::quantizeNormal(1.0, 0.0));
+  EXPECT_EQ(normalSeen(map, 10, 0, kids[1], tree), DpSlamMap::quantizeNormal(0.0, 1.0));
+  EXPECT_EQ(normalSeen(map, 10, 0, root, tree), 0);
+  int n = 0;
+  map.cellEntries(10, 0, &n);
+  EXPECT_EQ(n, 3);
+  // A no-return beam from the south through the cell: for the first sibling the cell's normal is across
+  // the beam (chord × 0.1), for the second along it (the whole chord) — about the same stops per metre, so
+  // the second sibling's beam is far likelier to stop there, i.e. less likely to get through.
+  MapBeam pass = along_y;
+  pass.range = 2.0;
+  pass.no_return = true;
+  const double ll0 = map.beamLogLikelihood(pass, 20.0, 0, cache, BeamModelConfig());
+  const double ll1 = map.beamLogLikelihood(pass, 20.0, 1, cache, BeamModelConfig());
+  EXPECT_GT(ll0, ll1 + 0.1);
+  // A copy keeps the visible entry's normal; a later stop with a new normal replaces it.
+  const auto grandkids = tree.advance(kids, {0, 0}, 2, map);
+  cache.begin(tree, grandkids);
+  MapBeam through = along_x;  // passes (10, 0) heading east, no return there: copies kids[0]'s entry
+  through.range = 3.0;
+  through.no_return = true;
+  map.addBeam(through, 20.0, 0, grandkids[0], cache);
+  EXPECT_EQ(map.lookup(10, 0, grandkids[0], tree)->owner, grandkids[0]);
+  EXPECT_EQ(normalSeen(map, 10, 0, grandkids[0], tree), DpSlamMap::quantizeNormal(1.0, 0.0));
+  map.addBeam(along_y, 20.0, 1, grandkids[1], cache);
+  EXPECT_EQ(normalSeen(map, 10, 0, grandkids[1], tree), DpSlamMap::quantizeNormal(0.0, 1.0));
+  EXPECT_EQ(map.check(), "");
+  // Node IDs must fit the entries' 16-bit owners.
+  std::vector<DpSlamMap::CellWrite> w{{1, 1, 0.1f, 0.0f}};
+  EXPECT_THROW(map.applyWrites(w, 0, DpSlamMap::kMaxNodeId + 1, cache), std::out_of_range);
+}
+
 TEST(DpSlamMap, ObservationModelValues) {
   AncestryTree tree;
   DpSlamMap map(0.1, 4.0);

@@ -332,6 +332,9 @@ TEST(DpSlam, InvalidConfigurationsAreRejected) {
   c = DpSlamConfig();
   c.cell_normal_min_cos = 1.5;
   EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c = DpSlamConfig();
+  c.particles = 10001;  // node IDs would not fit the map's 16-bit owners
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
 }
 
 // cell_normal_min_cos: the scan's fitted normals reach the map's cells (none are stored when it is off),
@@ -341,7 +344,11 @@ TEST(DpSlam, CellNormalsReachTheMapAndKeepTheLoopClosed) {
     int x0, y0, x1, y1, count = 0;
     if (!slam.map().bounds(&x0, &y0, &x1, &y1)) return 0;
     for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) count += slam.map().cellNormal(x, y) != 0;
+      for (int x = x0; x <= x1; ++x) {
+        int n = 0;
+        const MapEntry* e = slam.map().cellEntries(x, y, &n);
+        count += std::any_of(e, e + n, [](const MapEntry& m) { return m.normal != 0; });
+      }
     }
     return count;
   };

@@ -20,7 +20,9 @@ namespace laser_dpslam {
 
 /// One lineage's statistics in one cell.
 struct MapEntry {
-  std::int32_t owner = -1;  ///< ancestry node ID
+  std::int16_t owner = -1;  ///< ancestry node ID (below kMaxNodeId: 16 bits keep the entry at 16 bytes)
+  std::uint8_t normal = 0;  ///< quantised normal of the surface the lineage saw here, see setCellNormals (0 = none)
+  std::uint8_t unused = 0;
   float hits = 0.0f;        ///< beams that stopped in the cell (cumulative over the lineage)
   float distance = 0.0f;    ///< m of beam travelled through the cell (cumulative, plus the prior)
   std::uint32_t back = 0;   ///< index of this entry in its owner's entry list
@@ -136,8 +138,11 @@ class DpSlamMap : public AncestryHooks {
   void setSurfaceDepth(double depth) { surface_depth_ = depth; }
   double surfaceDepth() const { return surface_depth_; }
   /// Cell normals. A cell in which a beam with a known surface normal (MapBeam::nx, ny) stopped remembers
-  /// that normal (the last one, to 0.7°; one per cell, shared by all particles: the local geometry hardly
-  /// differs between them). Then distance through the cell counts along its normal — times |cos| between
+  /// that normal (the last one, to 0.7°) in the writing lineage's entry (MapEntry::normal), so each particle
+  /// sees the normals of its own history, as it sees its own stops: one normal per cell shared by all
+  /// particles (last writer wins) let a lineage's normals shape the others' scores and lost loop closures
+  /// on the MIT CSAIL log (6 of 20 filter seeds vs 0, README "Benchmarks"). Then distance through the cell
+  /// counts along its normal — times |cos| between
   /// the beam and the normal, bounded below by `min_cos` — for every beam that crosses it, in the writes and
   /// in both likelihoods alike, whether the beam ends there or passes by: the cell holds stops per metre of
   /// normal depth. This is setSurfaceDepth for the beams that pass a surface instead of ending on it: the
@@ -147,9 +152,10 @@ class DpSlamMap : public AncestryHooks {
   /// Cells without a normal keep the setSurfaceDepth rule. 0 = off.
   void setCellNormals(double min_cos) { cell_normal_min_cos_ = min_cos; }
   double cellNormals() const { return cell_normal_min_cos_; }
-  /// The quantised normal stored in cell (ix, iy): 0 = none, else k in 1..255 for the angle (k − ½)·π/255.
-  int cellNormal(int ix, int iy) const;
+  /// A quantised normal (MapEntry::normal): 0 = none, else k in 1..255 for the angle (k − ½)·π/255.
   static int quantizeNormal(double nx, double ny);  ///< 0 for (0, 0)
+  /// Node IDs above this do not fit MapEntry::owner (DpSlamConfig caps particles well below it).
+  static constexpr int kMaxNodeId = 32767;
   int cellIndex(double v) const { return static_cast<int>(std::floor(v / resolution_)); }
 
   // --- Raw access ---
@@ -192,7 +198,7 @@ class DpSlamMap : public AncestryHooks {
     std::int32_t ix, iy;
     float d;    ///< m of beam through the cell
     float hit;  ///< 1 for the cell where the beam stopped, else 0
-    std::uint8_t normal = 0;  ///< quantised normal the cell takes (0 = leave it), see setCellNormals
+    std::uint8_t normal = 0;  ///< quantised normal the writer's entry takes (0 = keep its own), see setCellNormals
   };
   void planBeam(const MapBeam& beam, double max_range, int slot, LookupCache& cache, double free_saturation,
                 std::vector<CellWrite>& out) const;
@@ -225,7 +231,6 @@ class DpSlamMap : public AncestryHooks {
     std::uint32_t block = 0;
     std::uint16_t size = 0;
     std::uint8_t cls = 0xFF;  ///< size class of the block (capacity 1 << cls); 0xFF = none
-    std::uint8_t normal = 0;  ///< quantised surface normal, see setCellNormals (0 = none)
   };
   struct Tile {
     int tx = 0, ty = 0;

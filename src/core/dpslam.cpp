@@ -29,7 +29,8 @@ void compose(Pose2D& a, Eigen::Matrix3d& cov_a, const Pose2D& b, const Eigen::Ma
 }  // namespace
 
 void DpSlamConfig::validate() const {
-  require(particles >= 1, "particles must be >= 1");
+  // ≤ 3P − 1 ancestry nodes during an update; their IDs must fit the map's 16-bit owners.
+  require(particles >= 1 && particles <= 10000, "particles must be in [1, 10000]");
   require(oversampling >= 1, "oversampling must be >= 1");
   require(cull_window > 0.0, "cull_window must be > 0");
   require(refine_iterations >= 0 && refine_halvings >= 0, "refine_iterations and refine_halvings must be >= 0");

@@ -8,6 +8,17 @@
 
 namespace laser_dpslam {
 
+static_assert(sizeof(MapEntry) == 16, "MapEntry grew: the map's memory is mostly entries");
+
+namespace {
+void requireNodeId(int node) {
+  if (node < 0 || node > DpSlamMap::kMaxNodeId) {
+    throw std::out_of_range("DpSlamMap: node ID " + std::to_string(node) + " outside [0, " +
+                            std::to_string(DpSlamMap::kMaxNodeId) + "]");
+  }
+}
+}  // namespace
+
 // ---------------------------------------------------------------------------------------------------
 // Entry blocks: size classes of capacity 1, 2, 4, … entries, carved out of fixed-size chunks so that a
 // growing map never reallocates (and copies) what it already holds. Freed blocks go to a per-class free
@@ -248,6 +259,7 @@ void DpSlamMap::deleteNode(int id) {
 }
 
 void DpSlamMap::mergeChildIntoParent(int child, int parent) {
+  requireNodeId(parent);
   const int need = std::max(child, parent) + 1;
   if (static_cast<int>(owned_.size()) < need) owned_.resize(need);
   auto& cl = owned_[child];
@@ -275,7 +287,7 @@ void DpSlamMap::mergeChildIntoParent(int child, int parent) {
       removeFromCell(tile, cell, dup);  // may move the child's entry: cl[i].slot follows
     }
     MapEntry& me = pool_->at(c.cls, c.block)[cl[i].slot];
-    me.owner = parent;
+    me.owner = static_cast<std::int16_t>(parent);
     me.back = static_cast<std::uint32_t>(pl.size());
     pl.push_back(cl[i]);
   }
@@ -466,11 +478,6 @@ int DpSlamMap::quantizeNormal(double nx, double ny) {
   return std::min(255, 1 + static_cast<int>(a * (255.0 / M_PI)));
 }
 
-int DpSlamMap::cellNormal(int ix, int iy) const {
-  const int t = tileId(ix, iy);
-  return t < 0 ? 0 : tiles_[t]->cells[cellInTile(ix, iy)].normal;
-}
-
 inline double DpSlamMap::chordFactor(int q, const MapBeam& b, bool near_return) const {
   if (q) {
     const NormalTable& n = normalTable();
@@ -488,6 +495,7 @@ struct Observation {
 }  // namespace
 
 void DpSlamMap::observe(int ix, int iy, int node, const AncestryTree& tree, double d, bool hit) {
+  requireNodeId(node);
   const int tile = ensureTile(ix, iy);
   const int cell = cellInTile(ix, iy);
   const MapEntry* vis = lookup(ix, iy, node, tree);
@@ -499,7 +507,7 @@ void DpSlamMap::observe(int ix, int iy, int node, const AncestryTree& tree, doub
     return;
   }
   MapEntry ne;
-  ne.owner = node;
+  ne.owner = static_cast<std::int16_t>(node);
   ne.hits = (vis ? vis->hits : 0.0f) + (hit ? 1.0f : 0.0f);
   ne.distance = vis ? vis->distance + static_cast<float>(d) : static_cast<float>(d + prior_distance_);
   ne.back = static_cast<std::uint32_t>(owned_[node].size());
@@ -528,7 +536,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
         const Cell& c = cur.t->cells[cell];
         const MapEntry& v = pool_->at(c.cls, c.block)[vis];
         if (!end && v.hits == 0.0f && v.distance >= saturation) return true;
-        if (normals) q = c.normal;
+        if (normals) q = v.normal;
       }
     }
     if (end && !q) q = beam_normal;  // a new surface cell: the normal it is about to take
@@ -542,6 +550,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
 void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache,
                             double free_saturation) {
   const float saturation = free_saturation > 0.0 ? static_cast<float>(free_saturation) : std::numeric_limits<float>::infinity();
+  requireNodeId(node);
   if (static_cast<int>(owned_.size()) <= node) owned_.resize(node + 1);
   Cursor cur;
   for (const CellWrite& w : writes) {
@@ -549,19 +558,21 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
     const int cell = cellInTile(w.ix, w.iy);
     const int vis = resolve(cur, cell, slot, cache);
     Cell& c = cur.t->cells[cell];
-    if (w.normal) c.normal = w.normal;
     MapEntry ne;
-    ne.owner = node;
+    ne.owner = static_cast<std::int16_t>(node);
+    ne.normal = w.normal;
     if (vis >= 0) {
       MapEntry& v = pool_->at(c.cls, c.block)[vis];
       if (w.hit == 0.0f && v.hits == 0.0f && v.distance >= saturation) continue;
       if (v.owner == node) {
         v.hits += w.hit;
         v.distance += w.d;
+        if (w.normal) v.normal = w.normal;
         continue;
       }
       ne.hits = v.hits + w.hit;
       ne.distance = v.distance + w.d;
+      if (!w.normal) ne.normal = v.normal;  // the copy keeps what the lineage saw
     } else {
       ne.hits = w.hit;
       ne.distance = w.d + static_cast<float>(prior_distance_);
@@ -603,8 +614,9 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
       const int vis = resolve(cur, cell, slot, cache);
       if (vis >= 0) {
         const Cell& c = cur.t->cells[cell];
-        mu = pool_->at(c.cls, c.block)[vis].density();
-        if (normals) q = c.normal;
+        const MapEntry& v = pool_->at(c.cls, c.block)[vis];
+        mu = v.density();
+        if (normals) q = v.normal;
       }
     }
     if (mu == 0.0) return true;
@@ -646,8 +658,9 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                  const int vis = resolve(cur, cell, slot, cache);
                  if (vis >= 0) {
                    const Cell& c = cur.t->cells[cell];
-                   mu = pool_->at(c.cls, c.block)[vis].density();
-                   if (cell_normal_min_cos_ > 0.0) q = c.normal;
+                   const MapEntry& v = pool_->at(c.cls, c.block)[vis];
+                   mu = v.density();
+                   if (cell_normal_min_cos_ > 0.0) q = v.normal;
                  }
                }
                if (mu == 0.0) return true;
