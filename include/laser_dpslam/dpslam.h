@@ -62,7 +62,7 @@ struct DpSlamConfig {
   double surface_min_cos = SurfaceIncidenceConfig().min_cos;  ///< lower bound of that projection (|cos| of the incidence; grazing fits are unreliable)
   /// [0, 1]: a cell a beam stopped in keeps that surface's normal, and distance through it counts along that
   /// normal for every beam crossing it, |cos| bounded below by this (DpSlamMap::setCellNormals; 0 = off)
-  double cell_normal_min_cos = 0.0;
+  double cell_normal_min_cos = 0.2;
   // --- Observation model ---
   /// m; returns within this of the scan's range_max are scored as free space up to range_max − this: the
   /// walls around them were written from poses behind, whose range ended short of them, and a stop wanted
