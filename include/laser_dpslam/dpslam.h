@@ -60,7 +60,7 @@ struct DpSlamConfig {
   /// normal of the surface hit, in writes and scores alike (DpSlamMap::setSurfaceDepth; 0 = off)
   double surface_depth = 0.5;
   double surface_min_cos = SurfaceIncidenceConfig().min_cos;  ///< lower bound of that projection (|cos| of the incidence; grazing fits are unreliable)
-  /// [0, 1]: a cell a beam stopped in keeps that surface's normal, and distance through it counts along that
+  /// [0, 1]: a cell a beam stopped in keeps that surface's normal (per lineage), and distance through it counts along that
   /// normal for every beam crossing it, |cos| bounded below by this (DpSlamMap::setCellNormals; 0 = off)
   double cell_normal_min_cos = 0.2;
   // --- Observation model ---
