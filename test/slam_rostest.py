@@ -39,8 +39,8 @@ class SlamRostest(unittest.TestCase):
         rospy.Subscriber("pose", PoseWithCovarianceStamped, lambda m: cls.poses.append(m))
         rospy.Subscriber("map", OccupancyGrid, lambda m: cls.maps.append(m))
         rospy.Subscriber("map_metadata", MapMetaData, lambda m: cls.metas.append(m))
-        # Wait (wall clock: the bag's simulated clock starts at 1000 s) until the bag, 98 s at rate 0.5,
-        # is played and the poses stop coming. Rate 0.5: run_tests runs other tests beside this one, and a
+        # Wait (wall clock: the bag's simulated clock starts at 1000 s) until the 98 s bag, played at rate 0.5
+        # (196 s), is over and the poses stop coming. Rate 0.5: run_tests runs other tests beside this one, and a
         # node that cannot keep up drops scans (638 poses of ~980 at rate 1.5, 895 at 1.0; the count fails).
         start = time.time()
         last = -1
