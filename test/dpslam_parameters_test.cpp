@@ -45,6 +45,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.score_no_return = !c.score_no_return;
   c.min_points = 9;
   c.occupancy_stop_length = 9;
+  c.trajectory_smoothing = 9;
   c.seed = 9;
   c.threads = 9;
   readDpSlamParameters(YamlParameterSource::load("config/dpslam.yaml"), c);
@@ -87,6 +88,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.score_no_return, d.score_no_return);
   EXPECT_EQ(c.min_points, d.min_points);
   EXPECT_EQ(c.occupancy_stop_length, d.occupancy_stop_length);
+  EXPECT_EQ(c.trajectory_smoothing, d.trajectory_smoothing);
   EXPECT_EQ(c.seed, d.seed);
   EXPECT_EQ(c.threads, d.threads);
   EXPECT_NO_THROW(c.validate());
@@ -118,6 +120,7 @@ TEST(DpSlamParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("surface_depth: -1").find("surface_depth"), std::string::npos);
   EXPECT_NE(message("surface_min_cos: 0").find("surface_min_cos"), std::string::npos);
   EXPECT_NE(message("score_range_margin: -0.1").find("score_range_margin"), std::string::npos);
+  EXPECT_NE(message("trajectory_smoothing: -1").find("trajectory_smoothing"), std::string::npos);
   EXPECT_NE(message("surface_min_cos: 1.5").find("surface_min_cos"), std::string::npos);
   EXPECT_NE(message("cell_normal_min_cos: 1.5").find("cell_normal_min_cos"), std::string::npos);
   EXPECT_NE(message("cell_normal_min_cos: -0.1").find("cell_normal_min_cos"), std::string::npos);

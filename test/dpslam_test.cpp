@@ -102,6 +102,27 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   EXPECT_LT(end_err, 0.05);
   EXPECT_LT(end_rot, 1.5 * M_PI / 180.0);
   EXPECT_LT(max_err, 0.12);
+  // The output path is the best lineage smoothed against the odometry (trajectory_smoothing): the same
+  // stamps, closer to the truth, and without the per-scan jitter the proposal noise leaves in a lineage.
+  const std::vector<StampedPose> lineage = slam.bestLineagePath();
+  ASSERT_EQ(lineage.size(), traj.size());
+  double err_lineage = 0.0, err_out = 0.0, jitter_lineage = 0.0, jitter_out = 0.0;
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    EXPECT_EQ(lineage[i].stamp, traj[i].stamp);
+    const Pose2D t = between(start, run.truth[i].pose);
+    err_lineage += std::pow(lineage[i].pose.x - t.x, 2) + std::pow(lineage[i].pose.y - t.y, 2);
+    err_out += std::pow(traj[i].pose.x - t.x, 2) + std::pow(traj[i].pose.y - t.y, 2);
+    if (i >= 2) {  // second differences of position: the scan-to-scan jitter
+      auto dd = [&](const std::vector<StampedPose>& p) {
+        return std::pow(p[i].pose.x - 2 * p[i - 1].pose.x + p[i - 2].pose.x, 2) +
+               std::pow(p[i].pose.y - 2 * p[i - 1].pose.y + p[i - 2].pose.y, 2);
+      };
+      jitter_lineage += dd(lineage);
+      jitter_out += dd(traj);
+    }
+  }
+  EXPECT_LT(err_out, err_lineage) << std::sqrt(err_out / traj.size()) << " against " << std::sqrt(err_lineage / traj.size());
+  EXPECT_LT(jitter_out, 0.5 * jitter_lineage) << jitter_out << " against " << jitter_lineage;
   // The map's walls are the floor plan's: occupied cells lie on the plan's walls, and the walls the robot
   // saw (the stub, the pillar, the cabinet, the outer walls) are in the map.
   const OccupancyGridData map = slam.bestMap();
@@ -141,9 +162,11 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
                    static_cast<int>((inside.y() - map.origin_y) / map.resolution)), 0);
   std::sort(ms.begin(), ms.end());
   std::printf("[ DpSlam   ] %zu scans, %d particles: per-scan median %.2f ms, p95 %.2f ms, max %.2f ms; "
-              "tree <= %zu nodes, <= %zu map entries (%.1f MB); end error %.3f m %.2f deg, max %.3f m\n",
+              "tree <= %zu nodes, <= %zu map entries (%.1f MB); end error %.3f m %.2f deg, max %.3f m; "
+              "RMS error %.4f m (lineage %.4f m)\n",
               ms.size(), config.particles, ms[ms.size() / 2], ms[ms.size() * 95 / 100], ms.back(), max_nodes,
-              max_entries, slam.memoryBytes() / 1e6, end_err, end_rot * 180 / M_PI, max_err);
+              max_entries, slam.memoryBytes() / 1e6, end_err, end_rot * 180 / M_PI, max_err,
+              std::sqrt(err_out / traj.size()), std::sqrt(err_lineage / traj.size()));
 }
 
 namespace {
@@ -270,6 +293,22 @@ TEST(DpSlam, UnusableScansMoveTheParticlesAndAreReported) {
   EXPECT_EQ(slam.particlePoses().size(), static_cast<std::size_t>(DpSlamConfig().particles));
 }
 
+// With trajectory_smoothing 0 the output path is the best lineage's own (the loop test above checks the
+// smoothed one against it).
+TEST(DpSlam, WithoutSmoothingTheOutputPathIsTheBestLineage) {
+  DpSlamConfig config;
+  config.trajectory_smoothing = 0.0;
+  DpSlam raw(config);
+  runSlam(config, 100, &raw);
+  const std::vector<StampedPose> a = raw.bestTrajectory(), b = raw.bestLineagePath();
+  ASSERT_EQ(a.size(), 100u);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].pose.x, b[i].pose.x);
+    EXPECT_EQ(a[i].pose.theta, b[i].pose.theta);
+  }
+}
+
 // While the robot explores, the particles' own fresh maps cannot tell their spread apart and the proposal
 // noise only random-walks the filter; explore_noise_scale shrinks it there, and back on old ground (the
 // second lap) the full noise returns.
@@ -331,6 +370,11 @@ TEST(DpSlam, InvalidConfigurationsAreRejected) {
   EXPECT_THROW(DpSlam{c}, std::invalid_argument);
   c = DpSlamConfig();
   c.cell_normal_min_cos = 1.5;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c = DpSlamConfig();
+  c.trajectory_smoothing = -1.0;
+  EXPECT_THROW(DpSlam{c}, std::invalid_argument);
+  c.trajectory_smoothing = std::nan("");
   EXPECT_THROW(DpSlam{c}, std::invalid_argument);
   c = DpSlamConfig();
   c.particles = 10001;  // node IDs would not fit the map's 16-bit owners

@@ -78,6 +78,9 @@ struct DpSlamConfig {
   int min_points = 20;          ///< fewer valid returns: the scan is not used (particles still move)
   // --- Output ---
   double occupancy_stop_length = 0.1;  ///< m; occupancy = 1 − exp(−density · this)
+  /// s; σ of the Gaussian window over which the output path (bestTrajectory) takes its pose from the SLAM
+  /// and its short-term motion from the odometry (trajectory_smoother.h; 0 = the best particle's raw path)
+  double trajectory_smoothing = 1.0;
   std::uint64_t seed = 1;              ///< random seed (same seed and input → same output)
   int threads = 2;                     ///< worker threads for scoring (results do not depend on it)
 
@@ -118,8 +121,11 @@ class DpSlam {
 
   bool initialized() const { return initialized_; }
   Pose2D bestPose() const;
-  /// The best particle's whole path: one pose per process() call since the first used scan.
+  /// The best particle's whole path: one pose per process() call since the first used scan, smoothed
+  /// against the motion given to process() over `trajectory_smoothing` seconds.
   std::vector<StampedPose> bestTrajectory() const;
+  /// The same path as the particle's lineage holds it (no smoothing).
+  std::vector<StampedPose> bestLineagePath() const;
   OccupancyGridData bestMap() const;
   std::vector<Pose2D> particlePoses() const;
   std::vector<double> logWeights() const { return logw_; }
@@ -168,6 +174,8 @@ class DpSlam {
   int best_ = 0;
   double last_neff_ = 0.0;
   Pose2D pending_;              ///< odometry motion since the last filter update (base frame then)
+  Pose2D motion_;               ///< all motion given to process() since the first used scan, composed
+  std::vector<StampedPose> motion_path_;  ///< motion_ at every pose of the particles' paths
   Eigen::Matrix3d pending_cov_ = Eigen::Matrix3d::Zero();
   Pose2D since_map_update_;     ///< filter motion since the last map update
   bool force_map_update_ = false;

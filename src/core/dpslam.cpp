@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "laser_dpslam/trajectory_smoother.h"
 #include "laser_dpslam/worker_pool.h"
 
 namespace laser_dpslam {
@@ -61,6 +62,7 @@ void DpSlamConfig::validate() const {
   require(beam.unknown_mean_free_path > 0.0, "unknown_mean_free_path must be > 0");
   require(min_points >= 1, "slam_min_points must be >= 1");
   require(occupancy_stop_length > 0.0, "occupancy_stop_length must be > 0");
+  require(trajectory_smoothing >= 0.0 && std::isfinite(trajectory_smoothing), "trajectory_smoothing must be >= 0");
   require(threads >= 1, "threads must be >= 1");
 }
 
@@ -98,6 +100,8 @@ void DpSlam::reset() {
   last_neff_ = 0.0;
   pending_ = Pose2D();
   pending_cov_.setZero();
+  motion_ = Pose2D();
+  motion_path_.clear();
   since_map_update_ = Pose2D();
   force_map_update_ = false;
   revisit_.reset();
@@ -232,6 +236,7 @@ void DpSlam::applyWrites(const std::vector<int>& who, const std::vector<int>& no
 }
 
 void DpSlam::record(double stamp) {
+  motion_path_.push_back({stamp, motion_});
   for (std::size_t j = 0; j < poses_.size(); ++j) {
     StampedPose sp;
     sp.stamp = stamp;
@@ -279,6 +284,7 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
   }
 
   compose(pending_, pending_cov_, delta, delta_cov);
+  motion_ = motion_ * delta;
   const bool moved_enough = (config_.min_travel_distance <= 0.0 && config_.min_travel_angle <= 0.0) ||
                             std::hypot(pending_.x, pending_.y) >= config_.min_travel_distance ||
                             std::abs(pending_.theta) >= config_.min_travel_angle;
@@ -421,8 +427,12 @@ void DpSlam::fill(DpSlamUpdate& u) const {
 
 Pose2D DpSlam::bestPose() const { return initialized_ ? poses_[best_] * pending_ : Pose2D(); }
 
-std::vector<StampedPose> DpSlam::bestTrajectory() const {
+std::vector<StampedPose> DpSlam::bestLineagePath() const {
   return initialized_ ? tree_.fullPath(leaves_[best_]) : std::vector<StampedPose>();
+}
+
+std::vector<StampedPose> DpSlam::bestTrajectory() const {
+  return smoothTrajectory(bestLineagePath(), motion_path_, config_.trajectory_smoothing);
 }
 
 OccupancyGridData DpSlam::bestMap() const {

@@ -84,6 +84,7 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
 
   // Output and execution.
   positive(s, "occupancy_stop_length", c.occupancy_stop_length);
+  nonNegative(s, "trajectory_smoothing", c.trajectory_smoothing);
   int seed = static_cast<int>(c.seed);
   if (s.get("seed", seed)) {
     require(seed >= 0, "seed", seed, "must be >= 0");
