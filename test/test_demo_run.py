@@ -63,8 +63,13 @@ class DemoRunTest(unittest.TestCase):
     def test_slam_log_follows_the_filter(self):
         out = tempfile.mkdtemp()
         log = os.path.join(out, "slam.csv")
+        # The raw best path (trajectory_smoothing 0): its last pose is the filter's own (the smoothed path's
+        # is the mean of the last seconds' corrections, ~1 mm away; test/trajectory_smoother_test.cpp).
+        config = os.path.join(out, "raw.yaml")
+        with open(config, "w") as f:
+            f.write("trajectory_smoothing: 0\n")
         p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", os.path.join(PKG, "bags", "demo.bag"),
-                            "--out", out, "--slam-log", log, "--quiet"], capture_output=True, text=True)
+                            "--out", out, "--config", config, "--slam-log", log, "--quiet"], capture_output=True, text=True)
         self.assertEqual(p.returncode, 0, p.stderr)
         rows = np.genfromtxt(log, delimiter=",", names=True)
         self.assertEqual(rows.dtype.names, ("stamp", "ok", "x", "y", "theta", "sxx", "syy", "stt", "neff",
