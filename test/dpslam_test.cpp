@@ -1,4 +1,5 @@
 #include "laser_dpslam/dpslam.h"
+#include "laser_dpslam/trajectory_smoother.h"
 
 #include <gtest/gtest.h>
 
@@ -307,6 +308,27 @@ TEST(DpSlam, WithoutSmoothingTheOutputPathIsTheBestLineage) {
     EXPECT_EQ(a[i].pose.x, b[i].pose.x);
     EXPECT_EQ(a[i].pose.theta, b[i].pose.theta);
   }
+}
+
+// The node smooths outside its lock from copies of the lineage and the motion path; that must be the very
+// output path bestTrajectory() gives.
+TEST(DpSlam, OutputPathIsTheLineageSmoothedAgainstTheMotionPath) {
+  DpSlamConfig config;
+  DpSlam slam(config);
+  runSlam(config, 100, &slam);
+  const std::vector<StampedPose> a = slam.bestTrajectory();
+  const std::vector<StampedPose> b =
+      smoothTrajectory(slam.bestLineagePath(), slam.motionPath(), config.trajectory_smoothing);
+  ASSERT_EQ(slam.motionPath().size(), 100u);
+  ASSERT_EQ(a.size(), b.size());
+  bool moved = false;
+  const std::vector<StampedPose> raw = slam.bestLineagePath();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].pose.x, b[i].pose.x);
+    EXPECT_EQ(a[i].pose.theta, b[i].pose.theta);
+    moved = moved || a[i].pose.x != raw[i].pose.x;
+  }
+  EXPECT_TRUE(moved);  // the smoothing did something, so the comparison above means something
 }
 
 // While the robot explores, the particles' own fresh maps cannot tell their spread apart and the proposal

@@ -126,6 +126,9 @@ class DpSlam {
   std::vector<StampedPose> bestTrajectory() const;
   /// The same path as the particle's lineage holds it (no smoothing).
   std::vector<StampedPose> bestLineagePath() const;
+  /// The motion given to process(), composed, at every pose of the paths: with bestLineagePath() the input
+  /// of smoothTrajectory(), so a caller holding a lock can copy both and smooth outside it.
+  const std::vector<StampedPose>& motionPath() const { return motion_path_; }
   OccupancyGridData bestMap() const;
   std::vector<Pose2D> particlePoses() const;
   std::vector<double> logWeights() const { return logw_; }

@@ -31,6 +31,7 @@
 #include "laser_dpslam/ros/ros_parameter_source.h"
 #include "laser_dpslam/ros/tf_wait.h"
 #include "laser_dpslam/scan_preprocessor.h"
+#include "laser_dpslam/trajectory_smoother.h"
 
 namespace laser_dpslam {
 
@@ -182,11 +183,15 @@ class DpSlamNode {
     nav_msgs::Path path;
     path.header.stamp = stamp;
     path.header.frame_id = map_frame_;
-    std::vector<StampedPose> traj;
+    // Copy under the lock, smooth outside it: smoothing costs O(poses x window) and grows with the run,
+    // and scans must not wait on it.
+    std::vector<StampedPose> lineage, motion;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      traj = slam_->bestTrajectory();
+      lineage = slam_->bestLineagePath();
+      motion = slam_->motionPath();
     }
+    const std::vector<StampedPose> traj = smoothTrajectory(lineage, motion, slam_config_.trajectory_smoothing);
     for (const auto& sp : traj) {
       geometry_msgs::PoseStamped ps;
       ps.header.stamp.fromSec(sp.stamp);
