@@ -317,12 +317,11 @@ TEST(DpSlam, OutputPathIsTheLineageSmoothedAgainstTheMotionPath) {
   DpSlam slam(config);
   runSlam(config, 100, &slam);
   const std::vector<StampedPose> a = slam.bestTrajectory();
-  const std::vector<StampedPose> b =
-      smoothTrajectory(slam.bestLineagePath(), slam.motionPath(), config.trajectory_smoothing);
+  const std::vector<StampedPose> raw = slam.bestLineagePath();
+  const std::vector<StampedPose> b = smoothTrajectory(raw, slam.motionPath(), config.trajectory_smoothing);
   ASSERT_EQ(slam.motionPath().size(), 100u);
   ASSERT_EQ(a.size(), b.size());
   bool moved = false;
-  const std::vector<StampedPose> raw = slam.bestLineagePath();
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].pose.x, b[i].pose.x);
     EXPECT_EQ(a[i].pose.theta, b[i].pose.theta);
