@@ -5,18 +5,25 @@
 # plus the largest position error the odometry picks up within 10 s (mostly the corridor lag: where the
 # scan cannot see motion along the corridor, the estimate falls behind — "maps come out too short").
 # One seed is not enough here: the outcome of a corridor stretch varies a lot with the noise.
+# --start-jitter: each seed's path is shifted by a seeded sub-cell offset (0-5 cm in x and y) and starts with
+# a 1 m lead-in at a seeded heading (within +-5 deg) before the first waypoint. The plan's walls lie on 5 cm
+# pixel edges and the SLAM's map frame is the first pose, so without it every wall lies exactly on a cell
+# boundary of the 5 cm grid, parallel to its rows: a coincidence a real run never has (doc/experiments.md).
 # Usage: scripts/benchmark_loop.sh [--seeds "1 2 3"] [--laps 2] [--config FILE.yaml] [--odometry-only]
+#                                  [--start-jitter]
 set -euo pipefail
 SEEDS="1 2 3"
 LAPS=2
 CONFIG=()
 SLAM=1
+JITTER=0
 while (($#)); do
   case "$1" in
     --seeds) SEEDS="$2"; shift 2 ;;
     --laps) LAPS="$2"; shift 2 ;;
     --config) CONFIG=(--config "$(realpath "$2")"); shift 2 ;;
     --odometry-only) SLAM=0; shift ;;
+    --start-jitter) JITTER=1; shift ;;
     *) echo "unknown argument: $1" >&2; exit 2 ;;
   esac
 done
@@ -50,11 +57,36 @@ ate() {  # estimate reference -> "ATE-RMSE drift-% distance-m"
 }
 
 printf "%-5s %7s | %-28s %-22s | %-10s %s\n" seed "metres" "odometry: ATE m, drift %" "worst 10 s error growth" "SLAM ATE m" "SLAM ms/scan (median)"
+# Seeded start jitter (see the header): the loop's waypoints shifted by (dx, dy), with a lead-in point 1 m
+# behind the first one at heading psi (the laps written out), so that the map frame (the first pose) is off the plan's lattice.
+JITTER_PY='
+import math, random, sys
+src, seed, laps = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+rng = random.Random(1000003 * seed + 17)
+dx, dy = rng.uniform(0.0, 0.05), rng.uniform(0.0, 0.05)
+psi = math.radians(rng.uniform(-5.0, 5.0))
+pts = [tuple(map(float, l.split()[:2])) for l in open(src) if l.strip() and not l.lstrip().startswith("#")]
+pts = [(x + dx, y + dy) for x, y in pts]
+hx, hy = pts[1][0] - pts[0][0], pts[1][1] - pts[0][1]
+h = math.atan2(hy, hx) + psi
+print("# %s shifted by (%.4f, %.4f) m, lead-in at %+.2f deg (benchmark_loop.sh --start-jitter, seed %d)"
+      % (src, dx, dy, math.degrees(psi), seed))
+print("%.4f %.4f" % (pts[0][0] - math.cos(h), pts[0][1] - math.sin(h)))
+for x, y in pts + pts[1:] * (laps - 1): print("%.4f %.4f" % (x, y))
+'
+
 for seed in $SEEDS; do
   dir="$OUT/seed$seed-laps$LAPS"
+  path=(--path loop --laps "$LAPS")
+  if ((JITTER)); then
+    dir="$dir-jitter"
+    mkdir -p "$dir"
+    /usr/bin/python3 -c "$JITTER_PY" "$REPO/plans/loop_building_loop.txt" "$seed" "$LAPS" > "$dir/waypoints.txt"
+    path=(--path "$dir/waypoints.txt")
+  fi
   mkdir -p "$dir"
   if [[ ! -f "$dir/sim.bag" ]]; then
-    rosrun laser_dpslam simulate_scans --floorplan "$REPO/plans/loop_building.yaml" --path loop --laps "$LAPS" \
+    rosrun laser_dpslam simulate_scans --floorplan "$REPO/plans/loop_building.yaml" "${path[@]}" \
       --seed "$seed" --out "$dir" > /dev/null
   fi
   mode=(--odometry-only)
