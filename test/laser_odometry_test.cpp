@@ -80,6 +80,41 @@ TEST(LaserOdometry, TracksASimulatedLoopWithSmallDrift) {
   EXPECT_LT(std::abs(normalizeAngle(odom.pose().theta - end_truth.theta)), 1.0 * M_PI / 180.0);
 }
 
+// align_to_walls: the match runs in a frame along the room's walls (the loop starts 16.4° off them), the
+// outputs stay in the odom frame (the first pose), with the same accuracy as above.
+TEST(LaserOdometry, AlignToWallsMatchesAlongTheWallsAndReportsInTheOdomFrame) {
+  const SimRun run = simulateLoop(1);
+  LaserOdometryConfig config;
+  config.align_to_walls = true;
+  LaserOdometry odom(config);
+  double max_err = 0.0;
+  const Pose2D start = run.truth.front().pose;
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    const OdometryUpdate u = odom.process(preprocessScan(run.scans[i], ScanPreprocessorConfig()), LaserMount());
+    ASSERT_TRUE(u.ok) << "scan " << i << ": " << u.skip_reason;
+    if (i == 0) {
+      EXPECT_NEAR(u.pose.x, 0.0, 1e-12);
+      EXPECT_NEAR(u.pose.y, 0.0, 1e-12);
+      EXPECT_NEAR(u.pose.theta, 0.0, 1e-12);
+    }
+    const Pose2D truth = between(start, run.truth[i].pose);
+    max_err = std::max(max_err, std::hypot(u.pose.x - truth.x, u.pose.y - truth.y));
+    const Pose2D p = odom.pose();
+    EXPECT_NEAR(p.x, u.pose.x, 1e-9);
+    EXPECT_NEAR(p.theta, u.pose.theta, 1e-9);
+  }
+  // The robot starts heading atan2(0.5, 1.7) = 16.4° in a room with axis-aligned walls.
+  EXPECT_NEAR(odom.frameAngle(), std::atan2(0.5, 1.7), 1.0 * M_PI / 180.0);
+  const Pose2D end_truth = between(start, run.truth.back().pose);
+  EXPECT_LT(std::hypot(odom.pose().x - end_truth.x, odom.pose().y - end_truth.y), 0.15);
+  EXPECT_LT(max_err, 0.15);
+  EXPECT_LT(std::abs(normalizeAngle(odom.pose().theta - end_truth.theta)), 1.0 * M_PI / 180.0);
+  // Off (the default): the matching frame is the odom frame.
+  LaserOdometry plain;
+  plain.process(preprocessScan(run.scans[0], ScanPreprocessorConfig()), LaserMount());
+  EXPECT_EQ(plain.frameAngle(), 0.0);
+}
+
 TEST(LaserOdometry, SameSeedGivesIdenticalPoses) {
   const SimRun run = simulateLoop(2);
   LaserOdometry a, b;

@@ -30,6 +30,8 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.degenerate_velocity_max_range, d.degenerate_velocity_max_range);
   EXPECT_EQ(o.prior_release_speed, d.prior_release_speed);
   EXPECT_EQ(o.map_voxel, d.map_voxel);
+  EXPECT_EQ(o.align_to_walls, d.align_to_walls);
+  EXPECT_EQ(o.wall_alignment_min_strength, d.wall_alignment_min_strength);
   EXPECT_EQ(o.min_points, d.min_points);
   EXPECT_EQ(o.max_prior_gap, d.max_prior_gap);
   EXPECT_EQ(o.seed, d.seed);

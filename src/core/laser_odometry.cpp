@@ -12,6 +12,7 @@ LaserOdometry::LaserOdometry(const LaserOdometryConfig& config)
 void LaserOdometry::reset() {
   initialized_ = false;
   pose_ = Pose2D();
+  frame_angle_ = 0.0;
   pose_covariance_.setZero();
   velocity_.setZero();
   keyframes_.clear();
@@ -67,6 +68,17 @@ void composeJacobians(const Pose2D& a, const Pose2D& b, Eigen::Matrix3d* Ja, Eig
 }  // namespace
 
 OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserMount& mount) {
+  OdometryUpdate u = processInFrame(scan, mount);
+  if (frame_angle_ != 0.0) {  // back to the odom frame; deltas and velocities are in base frames already
+    u.pose = toOdom(u.pose);
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    R.topLeftCorner<2, 2>() = Pose2D(0.0, 0.0, -frame_angle_).rotation();
+    u.pose_covariance = R * u.pose_covariance * R.transpose();
+  }
+  return u;
+}
+
+OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const LaserMount& mount) {
   OdometryUpdate u;
   u.stamp = scan.stamp;
 
@@ -101,7 +113,13 @@ OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserM
   if (!initialized_) {
     initialized_ = true;
     last_stamp_ = scan.stamp;
-    pose_ = Pose2D();
+    frame_angle_ = 0.0;
+    if (config_.align_to_walls) {
+      // Walls at angle a in the base frame lie along the axes of a frame in which the robot heads −a.
+      const WallDirection w = dominantWallDirection(base_points);
+      if (w.strength >= config_.wall_alignment_min_strength) frame_angle_ = -w.angle;
+    }
+    pose_ = Pose2D(0.0, 0.0, frame_angle_);
     pose_covariance_.setZero();
     velocity_.setZero();
     addKeyframe(base_points);

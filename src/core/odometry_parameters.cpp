@@ -50,6 +50,11 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   nonNegative(s, "degenerate_velocity_max_range", o.degenerate_velocity_max_range);
   nonNegative(s, "prior_release_speed", o.prior_release_speed);
   nonNegative(s, "map_voxel", o.map_voxel);
+  s.get("align_to_walls", o.align_to_walls);
+  if (s.get("wall_alignment_min_strength", o.wall_alignment_min_strength)) {
+    require(o.wall_alignment_min_strength >= 0.0 && o.wall_alignment_min_strength <= 1.0, "wall_alignment_min_strength",
+            o.wall_alignment_min_strength, "must be in [0, 1]");
+  }
   atLeast(s, "min_points", o.min_points, 3);
   positive(s, "max_prior_gap", o.max_prior_gap);
   int seed = static_cast<int>(o.seed);

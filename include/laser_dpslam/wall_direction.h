@@ -1,0 +1,28 @@
+// The dominant wall direction of a scan, modulo 90° (indoor walls mostly meet at right angles). The laser
+// odometry turns its local map's grid to it: NDT's cells are axis-aligned, and the same scans matched in a
+// frame whose axes run along the walls drift half as much on the simulated loop building as in one turned
+// by a few degrees (README "Benchmarks", doc/experiments.md). No ROS.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace laser_dpslam {
+
+struct WallDirection {
+  double angle = 0.0;     ///< rad in (−π/4, π/4]: the walls run along this angle or at 90° to it
+  double strength = 0.0;  ///< [0, 1]: length of the mean resultant of the chords' 4·angle (1 = all chords agree)
+  int chords = 0;         ///< chords used
+};
+
+/// From points in scan order (consecutive beams, in the scanner's or the robot's frame): a chord from each
+/// point p to the first following point at least L(p) = min_chord + chord_per_metre·|p| away, dropped when
+/// longer than 2·L(p) (a gap, another surface) or when the point halfway between them lies more than 0.15·L(p)
+/// off it (a corner). Short chords carry the range noise (URG-04LX: 1 % of the
+/// range, so ±0.6 rad per 0.1 m chord at 4 m), hence chords that grow with the range. Each chord votes with
+/// its angle times 4 (so directions 90° apart agree) on the unit circle; the angle of the mean resultant over
+/// 4 is the dominant direction. angle 0, strength 0 when there is no chord.
+WallDirection dominantWallDirection(const std::vector<Eigen::Vector2d>& ordered_points, double min_chord = 0.1,
+                                    double chord_per_metre = 0.1);
+
+}  // namespace laser_dpslam
