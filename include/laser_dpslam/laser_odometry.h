@@ -64,7 +64,8 @@ struct LaserOdometryConfig {
   /// that scan shows a clear direction (strength ≥ wall_alignment_min_strength); outputs stay in the odom
   /// frame (the first pose). NDT's cells are axis-aligned, and with walls oblique to them the match drifts
   /// more along corridors: on the loop building started a few degrees off the walls, odometry ATE mean
-  /// 0.187 m over seeds 1–12 against 0.10 m in a wall-aligned frame (doc/experiments.md).
+  /// 0.187 m over seeds 1–12, 0.092 m with this on (doc/experiments.md). Off by default: with walls lying
+  /// exactly on cell boundaries (the lattice-aligned simulation) the estimate's 0.05–0.5° error makes it worse.
   bool align_to_walls = false;
   double wall_alignment_min_strength = 0.3;  ///< [0, 1]
   int min_points = 20;               ///< fewer valid points: the scan is skipped
@@ -83,7 +84,7 @@ struct OdometryUpdate {
   Pose2D delta;                       ///< motion since the previous scan, in the previous base frame
   Eigen::Matrix3d delta_covariance = Eigen::Matrix3d::Identity();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< (vx, vy, ω) in the base frame
-  MatchResult match;
+  MatchResult match;                  ///< its pose and weak_direction are in the matching frame (frameAngle())
   bool new_keyframe = false;
   int points_used = 0;
 };
@@ -109,7 +110,7 @@ class LaserOdometry {
   struct Keyframe {
     Pose2D pose;
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of `pose`, odom frame
-    std::vector<Eigen::Vector2d> points;  ///< in the odom frame
+    std::vector<Eigen::Vector2d> points;  ///< in the matching frame (the odom frame unless align_to_walls)
   };
   void addKeyframe(const std::vector<Eigen::Vector2d>& base_points);
   /// process() in the matching frame: u.pose, u.pose_covariance and pose_ are in it.
