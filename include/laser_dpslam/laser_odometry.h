@@ -15,7 +15,6 @@
 #include "laser_dpslam/scan_matcher.h"
 #include "laser_dpslam/scan_preprocessor.h"
 #include "laser_dpslam/scan_resampler.h"
-#include "laser_dpslam/wall_direction.h"
 
 namespace laser_dpslam {
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "laser_dpslam/voxel_filter.h"
+#include "laser_dpslam/wall_direction.h"
 
 namespace laser_dpslam {
 
