@@ -153,6 +153,31 @@ class EvaluateTrajectoryTest(unittest.TestCase):
         self.assertAlmostEqual(r['rpe_rot_deg_per_m'], 2.0, places=5)
         self.assertLess(r['ate_rmse_m'], 1e-6)
 
+    def test_worst_segment_splits_a_stall_along_the_motion(self):
+        # A straight 10 m run heading 0.3 rad; between 4 and 5 m the estimate advances half as far and moves
+        # 0.2 m to the left (a corridor stall with a side step), then follows exactly, lagging from there on.
+        a = 0.3
+        ref = [(0.1 * k, 0.1 * k * math.cos(a), 0.1 * k * math.sin(a), a) for k in range(101)]
+        ref_path = os.path.join(self.dir, 'line.tum')
+        write(ref_path, ref)
+        est, s, left = [], 0.0, 0.0
+        for k in range(101):
+            if k > 0:
+                s += 0.05 if 40 < k <= 50 else 0.1
+                left += 0.02 if 40 < k <= 50 else 0.0
+            est.append((0.1 * k, s * math.cos(a) - left * math.sin(a), s * math.sin(a) + left * math.cos(a), a))
+        w = self.evaluate(est, ref=ref_path)['rpe_worst']
+        self.assertAlmostEqual(w['t_s'], 4.0, places=6)
+        self.assertAlmostEqual(w['x'], 4.0 * math.cos(a), places=6)
+        self.assertAlmostEqual(w['y'], 4.0 * math.sin(a), places=6)
+        self.assertAlmostEqual(w['length_m'], 1.0, places=6)
+        self.assertAlmostEqual(w['along_m'], -0.5, places=6)
+        self.assertAlmostEqual(w['across_m'], 0.2, places=6)
+        self.assertAlmostEqual(w['rot_deg'], 0.0, places=6)
+        # No pair is worse when the run is exact, and a path shorter than --rpe-distance has none.
+        self.assertAlmostEqual(self.evaluate(ref, ref=ref_path)['rpe_worst']['along_m'], 0.0, places=9)
+        self.assertIsNone(self.evaluate(est, '--rpe-distance', '20', ref=ref_path)['rpe_worst'])
+
     def test_association_interpolates_and_drops(self):
         # Estimate at stamps between the reference's, some before and after its span.
         est = [(t + 0.05, x + 0.05 * math.cos(th), y + 0.05 * math.sin(th), th) for t, x, y, th in self.ref[:24]]
