@@ -45,6 +45,22 @@ struct World {
   }
 };
 
+// One lineage (the root) on a 0.1 m map, and beams along +x from the middle of a cell.
+struct OneLineage {
+  AncestryTree tree;
+  DpSlamMap map{0.1, 4.0};
+  int root = tree.createRoot();
+  LookupCache cache;
+  OneLineage() { cache.begin(tree, {root}); }
+  static MapBeam alongX(double oy, double range) {
+    MapBeam b;
+    b.ox = 0.05;
+    b.oy = oy;
+    b.range = range;
+    return b;
+  }
+};
+
 }  // namespace
 
 TEST(TraceCells, ChordsMatchDenseSamplingOfTheRay) {
@@ -237,15 +253,11 @@ TEST(DpSlamMap, GrowsInEveryDirection) {
 }
 
 TEST(DpSlamMap, AddBeamWritesChordsAndTheHit) {
-  AncestryTree tree;
-  DpSlamMap map(0.1, 4.0);
-  const int root = tree.createRoot();
-  LookupCache cache;
-  cache.begin(tree, {root});
-  MapBeam b;
-  b.ox = 0.05;
-  b.oy = 0.05;
-  b.range = 0.72;  // ends at x = 0.77, in cell 7, 0.07 m into it
+  OneLineage w;
+  DpSlamMap& map = w.map;
+  const int root = w.root;
+  LookupCache& cache = w.cache;
+  MapBeam b = OneLineage::alongX(0.05, 0.72);  // ends at x = 0.77, in cell 7, 0.07 m into it
   map.addBeam(b, 20.0, 0, root, cache);
   map.addBeam(b, 20.0, 0, root, cache);  // twice: in place
   int n = 0;
@@ -269,6 +281,30 @@ TEST(DpSlamMap, AddBeamWritesChordsAndTheHit) {
   EXPECT_NEAR(e->distance, 0.05 + 0.4, 1e-6);
   EXPECT_EQ(map.cellEntries(6, 10, &n), nullptr);
   EXPECT_EQ(map.check(), "");
+}
+
+// planBeam's only_unknown (revisit_freeze_map): the cells the lineage already has an entry for are left
+// out, those it has none for are planned as usual; another lineage without the entries plans them all.
+TEST(DpSlamMap, PlanBeamOnlyUnknownLeavesTheKnownCellsOut) {
+  OneLineage w;
+  w.map.addBeam(OneLineage::alongX(0.05, 0.32), 20.0, 0, w.root, w.cache);  // cells 0-3 known, the return in cell 3
+  MapBeam b = OneLineage::alongX(0.05, 0.72);  // now through cells 0-7, the return in cell 7
+  std::vector<DpSlamMap::CellWrite> all, unknown;
+  w.map.planBeam(b, 20.0, 0, w.cache, 0.0, all);
+  w.map.planBeam(b, 20.0, 0, w.cache, 0.0, unknown, true);
+  ASSERT_EQ(all.size(), 8u);
+  ASSERT_EQ(unknown.size(), 4u);
+  for (std::size_t k = 0; k < unknown.size(); ++k) {
+    EXPECT_EQ(unknown[k].ix, static_cast<int>(k) + 4);
+    EXPECT_EQ(unknown[k].d, all[k + 4].d);
+    EXPECT_EQ(unknown[k].hit, all[k + 4].hit);
+  }
+  EXPECT_EQ(unknown.back().hit, 1.0f);
+  // A row the root's entries are not visible to (a beam elsewhere) is all unknown.
+  b.oy = 1.05;
+  unknown.clear();
+  w.map.planBeam(b, 20.0, 0, w.cache, 0.0, unknown, true);
+  EXPECT_EQ(unknown.size(), 8u);
 }
 
 // setSurfaceDepth: within the depth of a return, distances count multiplied by the beam's incidence, in

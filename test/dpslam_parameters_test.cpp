@@ -43,6 +43,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.beam.unknown_mean_free_path = 99;
   c.score_beam_step = 9;
   c.score_no_return = !c.score_no_return;
+  c.revisit_freeze_map = !c.revisit_freeze_map;
   c.min_points = 9;
   c.occupancy_stop_length = 9;
   c.trajectory_smoothing = 9;
@@ -86,6 +87,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.score_beam_step, d.score_beam_step);
   EXPECT_EQ(c.likelihood_weight, d.likelihood_weight);
   EXPECT_EQ(c.score_no_return, d.score_no_return);
+  EXPECT_EQ(c.revisit_freeze_map, d.revisit_freeze_map);
   EXPECT_EQ(c.min_points, d.min_points);
   EXPECT_EQ(c.occupancy_stop_length, d.occupancy_stop_length);
   EXPECT_EQ(c.trajectory_smoothing, d.trajectory_smoothing);

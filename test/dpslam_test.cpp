@@ -373,6 +373,43 @@ TEST(DpSlam, ExploringShrinksTheProposalNoiseAndRevisitsRestoreIt) {
   EXPECT_GT(mean(scaled, half, scaled.size()), 1.3 * explore_scaled);
 }
 
+// revisit_freeze_map: on old ground the scans add only new cells, so the second lap adds far fewer map
+// entries than it does with the map updated everywhere, and the loop stays closed as tightly.
+TEST(DpSlam, RevisitFreezeAddsOnlyNewCellsOnOldGround) {
+  const SimRun& run = loopRun();
+  auto secondLap = [&](bool freeze, double* end_err, double* max_err) {
+    DpSlamConfig config;
+    config.revisit_freeze_map = freeze;
+    DpSlam slam(config);
+    std::size_t entries_at_half = 0, revisits = 0, entries_end = 0;
+    for (std::size_t i = 0; i < run.scans.size(); ++i) {
+      const DpSlamUpdate u = slam.process(run.scans[i].stamp, run.scans[i], LaserMount(), run.odometry[i].delta,
+                                          run.odometry[i].delta_covariance);
+      if (i == run.scans.size() / 2) entries_at_half = u.map_entries;
+      if (i > run.scans.size() / 2) revisits += u.revisit ? 1 : 0;
+      entries_end = u.map_entries;
+    }
+    EXPECT_GT(revisits, run.scans.size() / 3);  // the second lap is on old ground
+    const Pose2D start = run.truth.front().pose;
+    const std::vector<StampedPose> traj = slam.bestTrajectory();
+    *max_err = 0.0;
+    for (std::size_t i = 0; i < traj.size(); ++i) {
+      const Pose2D t = between(start, run.truth[i].pose);
+      *max_err = std::max(*max_err, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
+    }
+    const Pose2D end_truth = between(start, run.truth.back().pose), end = slam.bestPose();
+    *end_err = std::hypot(end.x - end_truth.x, end.y - end_truth.y);
+    return static_cast<double>(entries_end) - static_cast<double>(entries_at_half);
+  };
+  double end_on, max_on, end_off, max_off;
+  const double added_on = secondLap(true, &end_on, &max_on), added_off = secondLap(false, &end_off, &max_off);
+  std::printf("[ DpSlam   ] second lap adds %.0f map entries frozen, %.0f updated; end error %.3f / %.3f m, max %.3f / %.3f m\n",
+              added_on, added_off, end_on, end_off, max_on, max_off);
+  EXPECT_LT(added_on, 0.5 * added_off);
+  EXPECT_LT(end_on, 0.05);
+  EXPECT_LT(max_on, 0.12);
+}
+
 TEST(DpSlam, InvalidConfigurationsAreRejected) {
   DpSlamConfig c;
   c.particles = 0;

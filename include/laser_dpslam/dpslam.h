@@ -44,6 +44,11 @@ struct DpSlamConfig {
   /// it find the older map's alignment. 1 = off.
   double explore_noise_scale = 0.25;
   double revisit_radius = 2.0;       ///< m, see explore_noise_scale
+  /// On old ground (see explore_noise_scale) the map keeps what it has: scans write only cells the particle
+  /// has no entry for (new space). Updated, a particle arriving 0.1-0.3 m off the old map writes its offset
+  /// view over it (5.6 m ahead of itself), those fresh walls outweigh the old ones, and the filter turns
+  /// along the ridge between them instead of stepping across (doc/experiments.md, twenty-third session).
+  bool revisit_freeze_map = true;
   double revisit_min_travel = 10.0;  ///< m of travel after which a stretch of path counts as old (revisitable)
   double min_travel_distance = 0.0;  ///< m; the filter updates once the robot moved this far ...
   double min_travel_angle = 0.0;     ///< rad; ... or turned this much since its last update (0 and 0 = every scan)

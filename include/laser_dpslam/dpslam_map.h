@@ -200,8 +200,9 @@ class DpSlamMap : public AncestryHooks {
     float hit;  ///< 1 for the cell where the beam stopped, else 0
     std::uint8_t normal = 0;  ///< quantised normal the writer's entry takes (0 = keep its own), see setCellNormals
   };
+  /// `only_unknown`: cells `slot` already has an entry for are left out as well (the map keeps what it has).
   void planBeam(const MapBeam& beam, double max_range, int slot, LookupCache& cache, double free_saturation,
-                std::vector<CellWrite>& out) const;
+                std::vector<CellWrite>& out, bool only_unknown = false) const;
   void applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache,
                    double free_saturation = 0.0);
 

@@ -223,7 +223,8 @@ void DpSlam::planWrites(const std::vector<int>& who, const std::vector<Pose2D>& 
     const int i = who[k];
     writes_[i].clear();
     for (const BaseBeam& b : update_beams_) {
-      map_.planBeam(toMap(at[i], b), config_.trace_max_range, i, caches_[w], config_.free_saturation_distance, writes_[i]);
+      map_.planBeam(toMap(at[i], b), config_.trace_max_range, i, caches_[w], config_.free_saturation_distance, writes_[i],
+                    config_.revisit_freeze_map && last_revisit_);
     }
   });
 }

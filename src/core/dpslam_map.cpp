@@ -516,7 +516,7 @@ void DpSlamMap::observe(int ix, int iy, int node, const AncestryTree& tree, doub
 }
 
 void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCache& cache, double free_saturation,
-                         std::vector<CellWrite>& out) const {
+                         std::vector<CellWrite>& out, bool only_unknown) const {
   const float saturation = free_saturation > 0.0 ? static_cast<float>(free_saturation) : std::numeric_limits<float>::infinity();
   const bool hit = !b.no_return && b.range <= max_range;
   const double length = std::min(b.range, max_range);
@@ -529,9 +529,10 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, length, resolution_, [&](int ix, int iy, double t0, double t1) {
     const bool end = hit && t1 >= length;
     int q = 0;  // the cell's normal, if it has statistics
-    if ((normals || !end) && seek(cur, ix, iy, cache)) {
+    if ((normals || !end || only_unknown) && seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
       const int vis = resolve(cur, cell, slot, cache);
+      if (vis >= 0 && only_unknown) return true;
       if (vis >= 0) {
         const Cell& c = cur.t->cells[cell];
         const MapEntry& v = pool_->at(c.cls, c.block)[vis];

@@ -45,6 +45,7 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
     require(c.explore_noise_scale > 0.0 && c.explore_noise_scale <= 1.0, "explore_noise_scale", c.explore_noise_scale,
             "must be in (0, 1]");
   }
+  s.get("revisit_freeze_map", c.revisit_freeze_map);
   positive(s, "revisit_radius", c.revisit_radius);
   nonNegative(s, "revisit_min_travel", c.revisit_min_travel);
   nonNegative(s, "min_travel_distance", c.min_travel_distance);
