@@ -66,6 +66,25 @@ std::vector<StampedPose> runSlam(const DpSlamConfig& config, std::size_t scans, 
   return slam.bestTrajectory();
 }
 
+// After a run over the whole loop: the best particle's final position error and the output path's largest
+// position error against the truth (m; the map frame is the first base frame).
+struct LoopError {
+  double end = 0.0, max = 0.0;
+};
+LoopError loopError(const DpSlam& slam) {
+  const SimRun& run = loopRun();
+  const Pose2D start = run.truth.front().pose;
+  const std::vector<StampedPose> traj = slam.bestTrajectory();
+  LoopError e;
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    const Pose2D t = between(start, run.truth[i].pose);
+    e.max = std::max(e.max, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
+  }
+  const Pose2D end_truth = between(start, run.truth.back().pose), end = slam.bestPose();
+  e.end = std::hypot(end.x - end_truth.x, end.y - end_truth.y);
+  return e;
+}
+
 }  // namespace
 
 TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
@@ -377,7 +396,7 @@ TEST(DpSlam, ExploringShrinksTheProposalNoiseAndRevisitsRestoreIt) {
 // entries than it does with the map updated everywhere, and the loop stays closed as tightly.
 TEST(DpSlam, RevisitFreezeAddsOnlyNewCellsOnOldGround) {
   const SimRun& run = loopRun();
-  auto secondLap = [&](bool freeze, double* end_err, double* max_err) {
+  auto secondLap = [&](bool freeze, LoopError* err) {
     DpSlamConfig config;
     config.revisit_freeze_map = freeze;
     DpSlam slam(config);
@@ -390,24 +409,16 @@ TEST(DpSlam, RevisitFreezeAddsOnlyNewCellsOnOldGround) {
       entries_end = u.map_entries;
     }
     EXPECT_GT(revisits, run.scans.size() / 3);  // the second lap is on old ground
-    const Pose2D start = run.truth.front().pose;
-    const std::vector<StampedPose> traj = slam.bestTrajectory();
-    *max_err = 0.0;
-    for (std::size_t i = 0; i < traj.size(); ++i) {
-      const Pose2D t = between(start, run.truth[i].pose);
-      *max_err = std::max(*max_err, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
-    }
-    const Pose2D end_truth = between(start, run.truth.back().pose), end = slam.bestPose();
-    *end_err = std::hypot(end.x - end_truth.x, end.y - end_truth.y);
+    *err = loopError(slam);
     return static_cast<double>(entries_end) - static_cast<double>(entries_at_half);
   };
-  double end_on, max_on, end_off, max_off;
-  const double added_on = secondLap(true, &end_on, &max_on), added_off = secondLap(false, &end_off, &max_off);
+  LoopError on, off;
+  const double added_on = secondLap(true, &on), added_off = secondLap(false, &off);
   std::printf("[ DpSlam   ] second lap adds %.0f map entries frozen, %.0f updated; end error %.3f / %.3f m, max %.3f / %.3f m\n",
-              added_on, added_off, end_on, end_off, max_on, max_off);
+              added_on, added_off, on.end, off.end, on.max, off.max);
   EXPECT_LT(added_on, 0.5 * added_off);
-  EXPECT_LT(end_on, 0.05);
-  EXPECT_LT(max_on, 0.12);
+  EXPECT_LT(on.end, 0.05);
+  EXPECT_LT(on.max, 0.12);
 }
 
 TEST(DpSlam, InvalidConfigurationsAreRejected) {
@@ -467,18 +478,11 @@ TEST(DpSlam, CellNormalsReachTheMapAndKeepTheLoopClosed) {
   two.threads = 2;
   expectIdentical(runFull(one, 120), runFull(two, 120), "cell normals, 1 vs 2 threads");
   // The whole two-lap loop, as ClosesASimulatedLoop... does with the defaults.
-  const SimRun& run = loopRun();
   DpSlam slam(on);
-  const std::vector<StampedPose> traj = runSlam(on, run.scans.size(), &slam);
-  const Pose2D start = run.truth.front().pose;
-  double max_err = 0.0;
-  for (std::size_t i = 0; i < traj.size(); ++i) {
-    const Pose2D t = between(start, run.truth[i].pose);
-    max_err = std::max(max_err, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
-  }
-  const Pose2D end_truth = between(start, run.truth.back().pose), end = slam.bestPose();
-  EXPECT_LT(std::hypot(end.x - end_truth.x, end.y - end_truth.y), 0.05);
-  EXPECT_LT(max_err, 0.12);
+  runSlam(on, loopRun().scans.size(), &slam);
+  const LoopError e = loopError(slam);
+  EXPECT_LT(e.end, 0.05);
+  EXPECT_LT(e.max, 0.12);
 }
 
 TEST(DpSlam, ScoreRangeMarginCutsTheScoredRangeOfShortRangeLasers) {
