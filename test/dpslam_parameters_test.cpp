@@ -47,6 +47,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.min_points = 9;
   c.occupancy_stop_length = 9;
   c.trajectory_smoothing = 9;
+  c.refine_trajectory = !c.refine_trajectory;
   c.seed = 9;
   c.threads = 9;
   readDpSlamParameters(YamlParameterSource::load("config/dpslam.yaml"), c);
@@ -91,6 +92,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.min_points, d.min_points);
   EXPECT_EQ(c.occupancy_stop_length, d.occupancy_stop_length);
   EXPECT_EQ(c.trajectory_smoothing, d.trajectory_smoothing);
+  EXPECT_EQ(c.refine_trajectory, d.refine_trajectory);
   EXPECT_EQ(c.seed, d.seed);
   EXPECT_EQ(c.threads, d.threads);
   EXPECT_NO_THROW(c.validate());

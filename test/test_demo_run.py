@@ -82,8 +82,16 @@ class DemoRunTest(unittest.TestCase):
         # The demo path starts on new ground and later comes back to where it started.
         self.assertEqual(int(rows["revisit"][:100].sum()), 0)
         self.assertGreater(int(rows["revisit"].sum()), 0)
-        # The best particle at the last scan is the one whose path trajectory.tum gives: same final pose.
-        t, x, y, th = load_tum(os.path.join(out, "trajectory.tum"))
+        # The best particle at the last scan is the one whose path trajectory_filter.tum gives (the filter's
+        # path; trajectory.tum is that path refined, refine_trajectory): same final pose.
+        t, x, y, th = load_tum(os.path.join(out, "trajectory_filter.tum"))
+        tr, xr, yr, _ = load_tum(os.path.join(out, "trajectory.tum"))
+        self.assertTrue(np.array_equal(t, tr))
+        self.assertLess(float(np.max(np.hypot(xr - x, yr - y))), 0.1)  # the refinement moves it by cm
+        with open(os.path.join(out, "stats.json")) as f:
+            refinement = json.load(f)["refinement"]
+        self.assertGreater(refinement["keyframes"], 100)
+        self.assertGreater(refinement["matches"], refinement["keyframes"])
         self.assertAlmostEqual(rows["stamp"][-1], t[-1], places=5)
         self.assertAlmostEqual(rows["x"][-1], x[-1], places=4)
         self.assertAlmostEqual(rows["y"][-1], y[-1], places=4)

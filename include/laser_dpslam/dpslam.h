@@ -86,6 +86,10 @@ struct DpSlamConfig {
   /// s; σ of the Gaussian window over which the output path (bestTrajectory) takes its pose from the SLAM
   /// and its short-term motion from the odometry (trajectory_smoother.h; 0 = the best particle's raw path)
   double trajectory_smoothing = 1.0;
+  /// dpslam_offline: trajectory.tum is the output path refined by a pose graph of keyframe matches
+  /// (trajectory_refiner.h) and trajectory_filter.tum the path as the filter left it; false = no refinement.
+  /// The SLAM itself (its map, its live pose) does not use it.
+  bool refine_trajectory = true;
   std::uint64_t seed = 1;              ///< random seed (same seed and input → same output)
   int threads = 2;                     ///< worker threads for scoring (results do not depend on it)
 

@@ -86,6 +86,7 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   // Output and execution.
   positive(s, "occupancy_stop_length", c.occupancy_stop_length);
   nonNegative(s, "trajectory_smoothing", c.trajectory_smoothing);
+  s.get("refine_trajectory", c.refine_trajectory);
   int seed = static_cast<int>(c.seed);
   if (s.get("seed", seed)) {
     require(seed >= 0, "seed", seed, "must be >= 0");

@@ -32,6 +32,7 @@
 #include "laser_dpslam/run_statistics.h"
 #include "laser_dpslam/scan_preprocessor.h"
 #include "laser_dpslam/trajectory_io.h"
+#include "laser_dpslam/trajectory_refiner.h"
 
 using namespace laser_dpslam;
 
@@ -208,6 +209,9 @@ int main(int argc, char** argv) {
   std::string slam_log = "stamp,ok,x,y,theta,sxx,syy,stt,neff,resampled,score_spread,revisit\n";
   std::string match_log = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt,pxx,pyy,ptt\n";
   LaserOdometry odometry(odom_config);
+  // The offline refinement of the output path keeps a keyframe (its scan's points) every 0.2 m.
+  const bool refine = !args.odometry_only && slam_config.refine_trajectory;
+  TrajectoryRefiner refiner;
   std::unique_ptr<DpSlam> slam;
   if (!args.odometry_only) slam = std::make_unique<DpSlam>(slam_config);
   Pose2D slam_last_odom;               // odometry pose of the last scan given to the SLAM
@@ -238,6 +242,7 @@ int main(int argc, char** argv) {
     ++time_resets;
     odom_poses.clear();
     if (slam) slam->reset();
+    refiner.clear();
     slam_has_last = false;
     slam_delta_cov.setZero();
   };
@@ -335,6 +340,7 @@ int main(int argc, char** argv) {
           continue;
         }
         odom_poses.push_back({scan.stamp, u.pose});
+        if (refine) refiner.addScan(scan.stamp, u.pose, mount.apply(pre.points), u.reset);
         odom_last_covariance = u.pose_covariance;
         last_stamp = scan.stamp;
         // The motion given to the SLAM: the laser odometry's, or --motion-tum's at this stamp.
@@ -392,14 +398,24 @@ int main(int argc, char** argv) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = processCpuSeconds() - cpu0;
+  RefinerStats refine_stats;
+  double refine_cpu_s = 0.0;
   const double duration = earlier_segments + (odom_poses.empty() ? 0.0 : last_stamp - first_stamp);
 
   try {
     writeFileAtomically(args.out + "/odometry.tum", formatTum(odom_poses));
     if (slam) {
-      const std::vector<StampedPose> trajectory = slam->bestTrajectory();
+      std::vector<StampedPose> trajectory = slam->bestTrajectory();
       const OccupancyGridData grid = slam->bestMap();
+      std::vector<StampedPose> trajectory_filter;
+      if (refine) {
+        const double r0 = processCpuSeconds();
+        trajectory_filter = trajectory;
+        trajectory = refiner.refine(trajectory, &refine_stats);
+        refine_cpu_s = processCpuSeconds() - r0;
+      }
       writeFileAtomically(args.out + "/trajectory.tum", formatTum(trajectory));
+      if (refine) writeFileAtomically(args.out + "/trajectory_filter.tum", formatTum(trajectory_filter));
       writeMapServerFiles(grid, args.out + "/map.yaml");
       writeMapPng(grid, trajectory, args.out + "/map.png");
     }
@@ -420,6 +436,14 @@ int main(int argc, char** argv) {
       json += "  \"tree_nodes_max\": " + std::to_string(max_tree_nodes) + ",\n";
       json += "  \"map_entries\": " + std::to_string(last_slam.map_entries) + ",\n";
       json += "  \"slam_memory_mb\": " + jsonNumber(last_slam.memory_bytes / 1048576.0) + ",\n";
+      // The output path's refinement (refine_trajectory; after the run, not in wall_s / cpu_s).
+      json += refine ? "  \"refinement\": {\"keyframes\": " + std::to_string(refine_stats.keyframes) +
+                           ", \"matches\": " + std::to_string(refine_stats.match_edges) +
+                           ", \"rejected_matches\": " + std::to_string(refine_stats.rejected_matches) +
+                           ", \"iterations\": " + std::to_string(refine_stats.graph.iterations) +
+                           ", \"max_shift_m\": " + jsonNumber(refine_stats.max_shift_m) +
+                           ", \"cpu_s\": " + jsonNumber(refine_cpu_s) + "},\n"
+                     : std::string("  \"refinement\": null,\n");
     }
     json += "  \"seed\": " + std::to_string(odom_config.seed) + ",\n";
     // The odometry's own pose uncertainty at the end (what /odom's pose covariance says): σ x, y, θ.
