@@ -27,10 +27,6 @@ Eigen::Matrix3d withoutDirection(const Eigen::Matrix3d& info, const Eigen::Vecto
   return keep.transpose() * info * keep;
 }
 
-Pose2D interpolate(const Pose2D& a, const Pose2D& b, double f) {
-  return {a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), normalizeAngle(a.theta + f * normalizeAngle(b.theta - a.theta))};
-}
-
 }  // namespace
 
 TrajectoryRefiner::TrajectoryRefiner(const TrajectoryRefinerConfig& config) : config_(config) {}
@@ -143,18 +139,16 @@ std::vector<StampedPose> TrajectoryRefiner::refine(const std::vector<StampedPose
 
   std::vector<Pose2D> refined = slam;
   st.graph = optimizePoseGraph(refined, edges, config_.graph, 0);
-  std::vector<Pose2D> correction(n);  // refined = correction ⊕ slam, in the map frame
+  std::vector<StampedPose> correction(n);  // refined = correction ⊕ slam, in the map frame
   for (int m = 0; m < n; ++m) {
-    correction[m] = refined[m] * slam[m].inverse();
+    correction[m] = {kf[m]->stamp, refined[m] * slam[m].inverse()};
     st.max_shift_m = std::max(st.max_shift_m, std::hypot(refined[m].x - slam[m].x, refined[m].y - slam[m].y));
   }
   std::vector<StampedPose> out = path;
-  int m = 0;
   for (auto& p : out) {
-    while (m + 1 < n && kf[m + 1]->stamp <= p.stamp) ++m;
-    Pose2D c = correction[m];
-    if (p.stamp > kf[m]->stamp && m + 1 < n) {
-      c = interpolate(correction[m], correction[m + 1], (p.stamp - kf[m]->stamp) / (kf[m + 1]->stamp - kf[m]->stamp));
+    Pose2D c;  // before the first keyframe and after the last: the nearest one's
+    if (!interpolatePose(correction, p.stamp, &c)) {
+      c = p.stamp < correction.front().stamp ? correction.front().pose : correction.back().pose;
     }
     p.pose = c * p.pose;
   }
