@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <random>
 
@@ -437,6 +438,73 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
   EXPECT_GT(ll_on, ll_off + 0.1);
   EXPECT_GT(on.beamEndpointLogLikelihood(g, 0.6, 0, c_on, BeamModelConfig()),
             off.beamEndpointLogLikelihood(g, 0.6, 0, c_off, BeamModelConfig()) + 0.1);
+  EXPECT_EQ(on.check(), "");
+}
+
+// setSurfaceOffsets: a cell with a normal keeps the mean offset of its stops along it, and a stop there is
+// scored where the beam crosses that line; without it, at the middle of the beam's chord through the cell.
+TEST(DpSlamMap, SurfaceOffsetsScoreAStopWhereTheWallIsInsideItsCell) {
+  AncestryTree tree;
+  const int root = tree.createRoot();
+  // A wall across row 0 at x = 1.02, inside cell 10 (x 1.0 .. 1.1, centre 1.05): head-on returns from
+  // x = 0.05 end at 1.01 .. 1.03, normal along x.
+  auto build = [&](DpSlamMap& map, LookupCache& cache) {
+    cache.begin(tree, {root});
+    for (int k = 0; k < 3; ++k) {
+      MapBeam b;
+      b.ox = 0.05;
+      b.oy = 0.05;
+      b.range = 0.96 + 0.01 * k;
+      b.nx = (k == 1 ? -1.0 : 1.0);  // a normal's sign does not matter
+      map.addBeam(b, 20.0, 0, root, cache);
+    }
+  };
+  DpSlamMap on(0.1, 4.0), off(0.1, 4.0);
+  on.setCellNormals(0.1);
+  off.setCellNormals(0.1);
+  EXPECT_FALSE(off.surfaceOffsets());
+  on.setSurfaceOffsets(true);
+  LookupCache c_on, c_off;
+  build(on, c_on);
+  build(off, c_off);
+  int n = 0;
+  const MapEntry* e = on.cellEntries(10, 0, &n);
+  ASSERT_EQ(n, 1);
+  // The mean of the stops' offsets, −0.03 m along +x from the centre (the quantised normal's sign decides
+  // the offset's), to the quantisation's 0.3 mm.
+  const int q = DpSlamMap::quantizeNormal(1.0, 0.0);
+  const double nx = std::cos((q - 0.5) * M_PI / 255.0);
+  EXPECT_NEAR(on.offsetValue(e->offset) * (nx > 0 ? 1.0 : -1.0), -0.03, 0.0005);
+  EXPECT_EQ(off.cellEntries(10, 0, &n)->offset, 0);  // off: nothing stored
+  // The same statistics otherwise.
+  EXPECT_EQ(e->hits, off.cellEntries(10, 0, &n)->hits);
+  EXPECT_NEAR(e->distance, off.cellEntries(10, 0, &n)->distance, 1e-6);
+  // Scored: with offsets a return at the wall (0.97) beats one at the cell's middle (1.0); without, the reverse.
+  auto ll = [&](DpSlamMap& map, LookupCache& cache, double range, bool cheap) {
+    MapBeam b;
+    b.ox = 0.05;
+    b.oy = 0.05;
+    b.range = range;
+    return cheap ? map.beamEndpointLogLikelihood(b, 0.3, 0, cache, BeamModelConfig())
+                 : map.beamLogLikelihood(b, 20.0, 0, cache, BeamModelConfig());
+  };
+  for (bool cheap : {false, true}) {
+    EXPECT_GT(ll(on, c_on, 0.97, cheap), ll(on, c_on, 1.0, cheap) + 0.002) << cheap;
+    EXPECT_GT(ll(off, c_off, 1.0, cheap), ll(off, c_off, 0.97, cheap) + 0.002) << cheap;
+  }
+  // A child's copy carries the offset on and averages its own stops into it; the root's stays.
+  const auto kids = tree.advance({root}, {0, 0}, 1, on);
+  c_on.begin(tree, kids);
+  MapBeam far;
+  far.ox = 0.05;
+  far.oy = 0.05;
+  far.range = 1.02;  // ends at x 1.07: offset +0.02 from the centre
+  far.nx = 1.0;
+  for (int k = 0; k < 4; ++k) on.addBeam(far, 20.0, 0, kids[0], c_on);
+  const MapEntry* child = on.lookup(10, 0, kids[0], tree);
+  ASSERT_EQ(child->owner, kids[0]);
+  EXPECT_NEAR(on.offsetValue(child->offset) * (nx > 0 ? 1.0 : -1.0), (3 * -0.03 + 4 * 0.02) / 7.0, 0.001);
+  EXPECT_NEAR(on.offsetValue(on.lookup(10, 0, kids[1], tree)->offset) * (nx > 0 ? 1.0 : -1.0), -0.03, 0.0005);
   EXPECT_EQ(on.check(), "");
 }
 

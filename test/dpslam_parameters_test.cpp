@@ -36,6 +36,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.surface_depth = 9;
   c.surface_min_cos = 0.9;
   c.cell_normal_min_cos = 0.9;
+  c.cell_surface_offsets = !c.cell_surface_offsets;
   c.score_range_margin = 9;
   c.beam.sigma = 9;
   c.beam.window = 9;
@@ -80,6 +81,7 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.surface_depth, d.surface_depth);
   EXPECT_EQ(c.surface_min_cos, d.surface_min_cos);
   EXPECT_EQ(c.cell_normal_min_cos, d.cell_normal_min_cos);
+  EXPECT_EQ(c.cell_surface_offsets, d.cell_surface_offsets);
   EXPECT_EQ(c.score_range_margin, d.score_range_margin);
   EXPECT_EQ(c.beam.sigma, d.beam.sigma);
   EXPECT_EQ(c.beam.window, d.beam.window);

@@ -68,6 +68,9 @@ struct DpSlamConfig {
   /// [0, 1]: a cell a beam stopped in keeps that surface's normal (per lineage), and distance through it counts along that
   /// normal for every beam crossing it, |cos| bounded below by this (DpSlamMap::setCellNormals; 0 = off)
   double cell_normal_min_cos = 0.2;
+  /// with cell normals: a cell also keeps where along its normal the surface lies (mean of its stops), and a
+  /// stop there is scored at the beam's crossing of that line, not the middle of the cell (DpSlamMap::setSurfaceOffsets)
+  bool cell_surface_offsets = true;
   // --- Observation model ---
   /// m; returns within this of the scan's range_max are scored as free space up to range_max − this: the
   /// walls around them were written from poses behind, whose range ended short of them, and a stop wanted

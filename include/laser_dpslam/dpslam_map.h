@@ -22,7 +22,7 @@ namespace laser_dpslam {
 struct MapEntry {
   std::int16_t owner = -1;  ///< ancestry node ID (below kMaxNodeId: 16 bits keep the entry at 16 bytes)
   std::uint8_t normal = 0;  ///< quantised normal of the surface the lineage saw here, see setCellNormals (0 = none)
-  std::uint8_t unused = 0;
+  std::uint8_t offset = 0;  ///< quantised position of that surface along the normal, see setSurfaceOffsets (0 = none)
   float hits = 0.0f;        ///< beams that stopped in the cell (cumulative over the lineage)
   float distance = 0.0f;    ///< m of beam travelled through the cell (cumulative, plus the prior)
   std::uint32_t back = 0;   ///< index of this entry in its owner's entry list
@@ -152,6 +152,19 @@ class DpSlamMap : public AncestryHooks {
   /// Cells without a normal keep the setSurfaceDepth rule. 0 = off.
   void setCellNormals(double min_cos) { cell_normal_min_cos_ = min_cos; }
   double cellNormals() const { return cell_normal_min_cos_; }
+  /// Sub-cell surface positions (with setCellNormals). A cell with a normal also keeps where along it the
+  /// surface lies: the mean, over the stops in it, of the return's offset from the cell's centre along the
+  /// normal (MapEntry::offset, to 0.4 % of a cell). A stop in that cell is then scored at the point where the
+  /// beam crosses that line (clamped to the beam's chord through the cell) instead of at the chord's middle:
+  /// a wall's range is known to a fraction of a cell wherever it lies against the grid, as an NDT cell's
+  /// mean is. Without it, walls that happen to lie on cell boundaries (parallel to the rows) are all seen at
+  /// the same depth, walls between them anywhere within half a cell, and the filter is pulled by the
+  /// difference (README "Benchmarks", start jitter). false = off.
+  void setSurfaceOffsets(bool on) { surface_offsets_ = on; }
+  bool surfaceOffsets() const { return surface_offsets_; }
+  /// MapEntry::offset: 0 = none, else k in 1..255 for (k − 128)/127 · 0.75 · resolution m.
+  int quantizeOffset(double s) const;
+  double offsetValue(int k) const { return (k - 128) * (0.75 * resolution_ / 127.0); }
   /// A quantised normal (MapEntry::normal): 0 = none, else k in 1..255 for the angle (k − ½)·π/255.
   static int quantizeNormal(double nx, double ny);  ///< 0 for (0, 0)
   /// Node IDs above this do not fit MapEntry::owner (DpSlamConfig caps particles well below it).
@@ -199,6 +212,7 @@ class DpSlamMap : public AncestryHooks {
     float d;    ///< m of beam through the cell
     float hit;  ///< 1 for the cell where the beam stopped, else 0
     std::uint8_t normal = 0;  ///< quantised normal the writer's entry takes (0 = keep its own), see setCellNormals
+    std::uint8_t offset = 0;  ///< a stop's quantised offset along the entry's (new) normal (0 = none), see setSurfaceOffsets
   };
   /// `only_unknown`: cells `slot` already has an entry for are left out as well (the map keeps what it has).
   void planBeam(const MapBeam& beam, double max_range, int slot, LookupCache& cache, double free_saturation,
@@ -274,6 +288,14 @@ class DpSlamMap : public AncestryHooks {
   double prior_distance_;  ///< m
   double surface_depth_ = 0.0;  ///< m, see setSurfaceDepth
   double cell_normal_min_cos_ = 0.0;  ///< see setCellNormals
+  bool surface_offsets_ = false;      ///< see setSurfaceOffsets
+  /// Beam parameter t (m) at which a stop in cell (ix, iy) with normal q and offset k counts: the beam's
+  /// crossing of the cell's surface line, clamped to [t0, t1]; the chord's middle without one.
+  double stopPoint(int ix, int iy, int q, int k, const MapBeam& b, double t0, double t1) const;
+  /// The running mean of an entry's offset after one more stop at `hit_offset` (quantised, along normal
+  /// `new_q`), from `old_k` along `old_q` over `old_hits` stops (an old stop without an offset counts as the
+  /// cell's centre).
+  std::uint8_t meanOffset(int old_q, int old_k, double old_hits, int new_q, int hit_offset) const;
   /// What a chord of beam b through a cell counts for: along the cell's quantised normal q when it has one
   /// (setCellNormals), else along the normal of the surface b ends on when `near_return` (setSurfaceDepth).
   double chordFactor(int q, const MapBeam& b, bool near_return) const;

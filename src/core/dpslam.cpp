@@ -77,6 +77,7 @@ DpSlam::DpSlam(const DpSlamConfig& config)
   config_.validate();
   map_.setSurfaceDepth(config_.surface_depth);
   map_.setCellNormals(config_.cell_normal_min_cos);
+  map_.setSurfaceOffsets(config_.cell_surface_offsets);
   RevisitDetectorConfig rc;
   rc.radius = config_.revisit_radius;
   rc.min_travel = config_.revisit_min_travel;

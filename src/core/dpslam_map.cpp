@@ -478,6 +478,38 @@ int DpSlamMap::quantizeNormal(double nx, double ny) {
   return std::min(255, 1 + static_cast<int>(a * (255.0 / M_PI)));
 }
 
+int DpSlamMap::quantizeOffset(double s) const {
+  const double k = std::round(s * (127.0 / (0.75 * resolution_))) + 128.0;
+  return static_cast<int>(std::min(255.0, std::max(1.0, k)));
+}
+
+inline double DpSlamMap::stopPoint(int ix, int iy, int q, int k, const MapBeam& b, double t0, double t1) const {
+  if (q && k) {
+    const NormalTable& n = normalTable();
+    const double cd = n.c[q] * b.dx + n.s[q] * b.dy;
+    if (std::abs(cd) > 1e-6) {
+      // n·(o + t·dir − centre) = offset
+      const double cx = (ix + 0.5) * resolution_ - b.ox, cy = (iy + 0.5) * resolution_ - b.oy;
+      const double t = (offsetValue(k) + n.c[q] * cx + n.s[q] * cy) / cd;
+      return std::min(t1, std::max(t0, t));
+    }
+  }
+  return 0.5 * (t0 + t1);
+}
+
+std::uint8_t DpSlamMap::meanOffset(int old_q, int old_k, double old_hits, int new_q, int hit_offset) const {
+  if (!new_q || !hit_offset) return static_cast<std::uint8_t>(old_k);
+  if (!(old_hits > 0.0)) return static_cast<std::uint8_t>(hit_offset);
+  double s_old = 0.0;
+  if (old_q && old_k) {
+    // The old surface line's point nearest the centre, measured along the new normal.
+    const NormalTable& n = normalTable();
+    s_old = offsetValue(old_k) * (n.c[old_q] * n.c[new_q] + n.s[old_q] * n.s[new_q]);
+  }
+  const double s = s_old + (offsetValue(hit_offset) - s_old) / (old_hits + 1.0);
+  return static_cast<std::uint8_t>(quantizeOffset(s));
+}
+
 inline double DpSlamMap::chordFactor(int q, const MapBeam& b, bool near_return) const {
   if (q) {
     const NormalTable& n = normalTable();
@@ -542,7 +574,16 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
     }
     if (end && !q) q = beam_normal;  // a new surface cell: the normal it is about to take
     CellWrite w{ix, iy, static_cast<float>((t1 - t0) * chordFactor(q, b, t1 >= surface_from)), end ? 1.0f : 0.0f};
-    if (end) w.normal = static_cast<std::uint8_t>(beam_normal);
+    if (end) {
+      w.normal = static_cast<std::uint8_t>(beam_normal);
+      const int nq = beam_normal ? beam_normal : q;  // the normal the entry has after this write
+      if (surface_offsets_ && nq) {
+        const NormalTable& n = normalTable();
+        const double px = b.ox + b.dx * length - (ix + 0.5) * resolution_;
+        const double py = b.oy + b.dy * length - (iy + 0.5) * resolution_;
+        w.offset = static_cast<std::uint8_t>(quantizeOffset(n.c[nq] * px + n.s[nq] * py));
+      }
+    }
     out.push_back(w);
     return true;
   });
@@ -562,18 +603,23 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
     MapEntry ne;
     ne.owner = static_cast<std::int16_t>(node);
     ne.normal = w.normal;
+    ne.offset = w.offset;
     if (vis >= 0) {
       MapEntry& v = pool_->at(c.cls, c.block)[vis];
       if (w.hit == 0.0f && v.hits == 0.0f && v.distance >= saturation) continue;
+      const int nq = w.normal ? w.normal : v.normal;
+      const std::uint8_t offset = w.offset ? meanOffset(v.normal, v.offset, v.hits, nq, w.offset) : v.offset;
       if (v.owner == node) {
         v.hits += w.hit;
         v.distance += w.d;
         if (w.normal) v.normal = w.normal;
+        v.offset = offset;
         continue;
       }
       ne.hits = v.hits + w.hit;
       ne.distance = v.distance + w.d;
       if (!w.normal) ne.normal = v.normal;  // the copy keeps what the lineage saw
+      ne.offset = offset;
     } else {
       ne.hits = w.hit;
       ne.distance = w.d + static_cast<float>(prior_distance_);
@@ -604,12 +650,13 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
   const double mu_unknown = 1.0 / m.unknown_mean_free_path;
   const double surface = no_return ? 0.0 : surface_depth_;  // setSurfaceDepth: |t - z| < this counts along the normal
   const bool normals = cell_normal_min_cos_ > 0.0;
+  const bool offsets = normals && surface_offsets_;
   double tau = 0.0, reach = 1.0, eval = 0.0;
   bool in_window = false;
   Cursor cur;
   traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, t_end, resolution_, [&](int ix, int iy, double t0, double t1) {
     double mu = mu_unknown;
-    int q = 0;
+    int q = 0, k = 0;
     if (seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
       const int vis = resolve(cur, cell, slot, cache);
@@ -618,6 +665,7 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
         const MapEntry& v = pool_->at(c.cls, c.block)[vis];
         mu = v.density();
         if (normals) q = v.normal;
+        if (offsets) k = v.offset;
       }
     }
     if (mu == 0.0) return true;
@@ -633,7 +681,7 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
     const double pass = std::exp(-mu * d);
     const double stop = reach * (1.0 - pass);
     reach *= pass;
-    const double e = 0.5 * (t0 + t1) - z;
+    const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
     if (std::abs(e) < m.window) eval += stop * std::exp(-e * e * inv_2s2);
     return reach > 1e-9;  // nothing left to explain: stop tracing
   });
@@ -653,7 +701,7 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
   traceCells(b.ox, b.oy, b.dx, b.dy, std::max(0.0, z - half_window), z + half_window, resolution_,
              [&](int ix, int iy, double t0, double t1) {
                double mu = mu_unknown;
-               int q = 0;
+               int q = 0, k = 0;
                if (seek(cur, ix, iy, cache)) {
                  const int cell = cellInTile(ix, iy);
                  const int vis = resolve(cur, cell, slot, cache);
@@ -661,7 +709,10 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                    const Cell& c = cur.t->cells[cell];
                    const MapEntry& v = pool_->at(c.cls, c.block)[vis];
                    mu = v.density();
-                   if (cell_normal_min_cos_ > 0.0) q = v.normal;
+                   if (cell_normal_min_cos_ > 0.0) {
+                     q = v.normal;
+                     if (surface_offsets_) k = v.offset;
+                   }
                  }
                }
                if (mu == 0.0) return true;
@@ -669,7 +720,7 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                const double pass = std::exp(-mu * d);
                const double stop = reach * (1.0 - pass);
                reach *= pass;
-               const double e = 0.5 * (t0 + t1) - z;
+               const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
                eval += stop * std::exp(-e * e * inv_2s2);
                return reach > 1e-9;
              });

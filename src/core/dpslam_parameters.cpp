@@ -67,6 +67,7 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
     require(c.cell_normal_min_cos >= 0.0 && c.cell_normal_min_cos <= 1.0, "cell_normal_min_cos", c.cell_normal_min_cos,
             "must be in [0, 1]");
   }
+  s.get("cell_surface_offsets", c.cell_surface_offsets);
   nonNegative(s, "map_update_distance", c.map_update_distance);
   nonNegative(s, "map_update_angle", c.map_update_angle);
 
