@@ -154,7 +154,7 @@ class DpSlamMap : public AncestryHooks {
   double cellNormals() const { return cell_normal_min_cos_; }
   /// Sub-cell surface positions (with setCellNormals). A cell with a normal also keeps where along it the
   /// surface lies: the mean, over the stops in it, of the return's offset from the cell's centre along the
-  /// normal (MapEntry::offset, to 0.4 % of a cell). A stop in that cell is then scored at the point where the
+  /// normal (MapEntry::offset, to 0.6 % of a cell). A stop in that cell is then scored at the point where the
   /// beam crosses that line (clamped to the beam's chord through the cell) instead of at the chord's middle:
   /// a wall's range is known to a fraction of a cell wherever it lies against the grid, as an NDT cell's
   /// mean is. Without it, walls that happen to lie on cell boundaries (parallel to the rows) are all seen at
