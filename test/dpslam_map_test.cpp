@@ -451,10 +451,7 @@ TEST(DpSlamMap, SurfaceOffsetsScoreAStopWhereTheWallIsInsideItsCell) {
   auto build = [&](DpSlamMap& map, LookupCache& cache) {
     cache.begin(tree, {root});
     for (int k = 0; k < 3; ++k) {
-      MapBeam b;
-      b.ox = 0.05;
-      b.oy = 0.05;
-      b.range = 0.96 + 0.01 * k;
+      MapBeam b = OneLineage::alongX(0.05, 0.96 + 0.01 * k);
       b.nx = (k == 1 ? -1.0 : 1.0);  // a normal's sign does not matter
       map.addBeam(b, 20.0, 0, root, cache);
     }
@@ -481,10 +478,7 @@ TEST(DpSlamMap, SurfaceOffsetsScoreAStopWhereTheWallIsInsideItsCell) {
   EXPECT_NEAR(e->distance, off.cellEntries(10, 0, &n)->distance, 1e-6);
   // Scored: with offsets a return at the wall (0.97) beats one at the cell's middle (1.0); without, the reverse.
   auto ll = [&](DpSlamMap& map, LookupCache& cache, double range, bool cheap) {
-    MapBeam b;
-    b.ox = 0.05;
-    b.oy = 0.05;
-    b.range = range;
+    const MapBeam b = OneLineage::alongX(0.05, range);
     return cheap ? map.beamEndpointLogLikelihood(b, 0.3, 0, cache, BeamModelConfig())
                  : map.beamLogLikelihood(b, 20.0, 0, cache, BeamModelConfig());
   };
@@ -495,10 +489,7 @@ TEST(DpSlamMap, SurfaceOffsetsScoreAStopWhereTheWallIsInsideItsCell) {
   // A child's copy carries the offset on and averages its own stops into it; the root's stays.
   const auto kids = tree.advance({root}, {0, 0}, 1, on);
   c_on.begin(tree, kids);
-  MapBeam far;
-  far.ox = 0.05;
-  far.oy = 0.05;
-  far.range = 1.02;  // ends at x 1.07: offset +0.02 from the centre
+  MapBeam far = OneLineage::alongX(0.05, 1.02);  // ends at x 1.07: offset +0.02 from the centre
   far.nx = 1.0;
   for (int k = 0; k < 4; ++k) on.addBeam(far, 20.0, 0, kids[0], c_on);
   const MapEntry* child = on.lookup(10, 0, kids[0], tree);
