@@ -26,6 +26,8 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   c.min_travel_distance = 9;
   c.min_travel_angle = 9;
   c.map_resolution = 9;
+  c.map_align_to_walls = !c.map_align_to_walls;
+  c.map_wall_min_strength = 0.9;
   c.trace_max_range = 99;
   c.no_return_range = 99;
   c.entry_prior_cells = 9;
@@ -71,6 +73,8 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.min_travel_distance, d.min_travel_distance);
   EXPECT_EQ(c.min_travel_angle, d.min_travel_angle);
   EXPECT_EQ(c.map_resolution, d.map_resolution);
+  EXPECT_EQ(c.map_align_to_walls, d.map_align_to_walls);
+  EXPECT_EQ(c.map_wall_min_strength, d.map_wall_min_strength);
   EXPECT_EQ(c.trace_max_range, d.trace_max_range);
   EXPECT_EQ(c.no_return_range, d.no_return_range);
   EXPECT_EQ(c.entry_prior_cells, d.entry_prior_cells);
@@ -131,5 +135,6 @@ TEST(DpSlamParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("cell_normal_min_cos: 1.5").find("cell_normal_min_cos"), std::string::npos);
   EXPECT_NE(message("cell_normal_min_cos: -0.1").find("cell_normal_min_cos"), std::string::npos);
   EXPECT_EQ(message("cell_normal_min_cos: 0"), "no error");
+  EXPECT_NE(message("map_wall_min_strength: 1.5").find("map_wall_min_strength"), std::string::npos);
   EXPECT_EQ(message("particles: 5"), "no error");
 }

@@ -496,3 +496,64 @@ TEST(DpSlam, ScoreRangeMarginCutsTheScoredRangeOfShortRangeLasers) {
   c.score_range_margin = -0.1;
   EXPECT_THROW(c.validate(), std::invalid_argument);
 }
+
+// map_align_to_walls: a robot starting 0.3 rad off the room's walls gets a map frame whose axes run along
+// them (its first pose heads +0.3 rad there), and keeps it; off, the first pose defines the frame. The
+// occupied cells of the exported map then fill few rows and columns (the walls on the grid's lattice).
+TEST(DpSlam, MapAlignToWallsTurnsTheMapFrameToTheFirstScansWalls) {
+  const FloorPlan room = test::furnishedRoom();
+  const double psi = 0.3;
+  const std::vector<Eigen::Vector2d> line{{1.5, 2.0}, {1.5 + 2.0 * std::cos(psi), 2.0 + 2.0 * std::sin(psi)}};
+  const std::vector<TimedPose> truth = samplePath(line, 10.0, PathConfig());
+  ASSERT_NEAR(truth.front().pose.theta, psi, 1e-9);
+  ScanSimulator sim(room, ScanSimulatorConfig(), 5);
+  LaserOdometry odom{LaserOdometryConfig()};
+  std::vector<PreprocessedScan> scans;
+  std::vector<OdometryUpdate> motion;
+  for (const auto& tp : truth) {
+    scans.push_back(preprocessScan(sim.simulate(tp.pose, 10.0 + tp.stamp), ScanPreprocessorConfig()));
+    motion.push_back(odom.process(scans.back(), LaserMount()));
+  }
+  // The output path, and the share of the exported map's occupied cells in the 8 rows and 8 columns that
+  // hold the most of them (walls along the grid's rows: high).
+  struct Out {
+    std::vector<StampedPose> path;
+    double on_lattice = 0.0;
+  };
+  auto run = [&](const DpSlamConfig& c) {
+    DpSlam slam(c);
+    for (std::size_t i = 0; i < scans.size(); ++i) {
+      slam.process(scans[i].stamp, scans[i], LaserMount(), motion[i].delta, motion[i].delta_covariance);
+    }
+    const OccupancyGridData g = slam.bestMap();
+    std::vector<int> rows(g.height, 0), cols(g.width, 0);
+    int occupied = 0;
+    for (int y = 0; y < g.height; ++y) {
+      for (int x = 0; x < g.width; ++x) {
+        if (g.at(x, y) >= 65) ++rows[y], ++cols[x], ++occupied;
+      }
+    }
+    std::sort(rows.rbegin(), rows.rend());
+    std::sort(cols.rbegin(), cols.rend());
+    int top = 0;
+    for (int k = 0; k < 8 && k < g.height; ++k) top += rows[k];
+    for (int k = 0; k < 8 && k < g.width; ++k) top += cols[k];
+    return Out{slam.bestTrajectory(), static_cast<double>(top) / std::max(occupied, 1)};
+  };
+  DpSlamConfig off, on, weak;
+  on.map_align_to_walls = true;
+  weak.map_align_to_walls = true;
+  weak.map_wall_min_strength = 1.0;  // no real scan agrees that much: the first pose stays the frame
+  const Out out_off = run(off), out_on = run(on);
+  const std::vector<StampedPose>&a = out_off.path, &b = out_on.path, c = run(weak).path;
+  ASSERT_EQ(a.size(), truth.size());
+  ASSERT_EQ(b.size(), truth.size());
+  EXPECT_NEAR(a.front().pose.theta, 0.0, 0.01);  // (the output path is smoothed)
+  EXPECT_NEAR(c.front().pose.theta, 0.0, 0.01);
+  EXPECT_NEAR(b.front().pose.theta, psi, 0.02);
+  EXPECT_NEAR(b.back().pose.theta, truth.back().pose.theta, 0.03);
+  // The same motion either way: only the frame turned.
+  const Pose2D ra = between(a.front().pose, a.back().pose), rb = between(b.front().pose, b.back().pose);
+  EXPECT_NEAR(std::hypot(ra.x - rb.x, ra.y - rb.y), 0.0, 0.05);
+  EXPECT_GT(out_on.on_lattice, out_off.on_lattice + 0.1);
+}

@@ -54,6 +54,11 @@ struct DpSlamConfig {
   double min_travel_angle = 0.0;     ///< rad; ... or turned this much since its last update (0 and 0 = every scan)
   // --- Map ---
   double map_resolution = 0.05;    ///< m per cell
+  /// The map frame's axes run along the first scan's dominant wall direction (wall_direction.h, modulo 90°)
+  /// instead of the first pose's heading: the grid's rows then lie along the walls, as they would on a plan,
+  /// and the first pose is (0, 0, −that angle). Only when the chords agree at least map_wall_min_strength.
+  bool map_align_to_walls = false;
+  double map_wall_min_strength = 0.3;  ///< [0, 1]
   double trace_max_range = 20.0;   ///< m; beams are traced this far at most, longer returns count as free space
   double no_return_range = 6.0;    ///< m; a no-return beam is free space up to min(this, the scan's range_max)
   double entry_prior_cells = 4.0;  ///< cells of distance a new cell entry starts with (DP-SLAM's prior)
@@ -126,7 +131,7 @@ class DpSlam {
 
   /// One scan. `delta`/`delta_cov`: the laser odometry's motion since the previous call (in the previous
   /// base frame) and its covariance; ignored on the first scan, which defines the map frame (= the base
-  /// frame at that scan). Skipped scans still move the particles by `delta`.
+  /// frame at that scan, turned to its walls with map_align_to_walls). Skipped scans still move the particles by `delta`.
   DpSlamUpdate process(double stamp, const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& delta,
                        const Eigen::Matrix3d& delta_cov);
   void reset();

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "laser_dpslam/trajectory_smoother.h"
+#include "laser_dpslam/wall_direction.h"
 #include "laser_dpslam/worker_pool.h"
 
 namespace laser_dpslam {
@@ -45,6 +46,7 @@ void DpSlamConfig::validate() const {
   require(revisit_min_travel >= 0.0, "revisit_min_travel must be >= 0");
   require(min_travel_distance >= 0.0 && min_travel_angle >= 0.0, "minimum travel must be >= 0");
   require(map_resolution > 0.0, "map_resolution must be > 0");
+  require(map_wall_min_strength >= 0.0 && map_wall_min_strength <= 1.0, "map_wall_min_strength must be in [0, 1]");
   require(trace_max_range > map_resolution, "trace_max_range must exceed map_resolution");
   require(no_return_range > 0.0, "no_return_range must be > 0");
   require(entry_prior_cells > 0.0, "entry_prior_cells must be > 0");
@@ -265,8 +267,14 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
     }
     makeBeams(scan, mount);
     const int P = config_.particles;
+    // The first pose defines the map frame; turned by the walls' angle, the grid's rows run along them.
+    Pose2D first;
+    if (config_.map_align_to_walls) {
+      const WallDirection w = dominantWallDirection(mount.apply(scan.points));
+      if (w.strength >= config_.map_wall_min_strength) first = Pose2D(0.0, 0.0, -w.angle);
+    }
     const int root = tree_.createRoot(0);
-    poses_.assign(P, Pose2D());
+    poses_.assign(P, first);
     logw_.assign(P, 0.0);
     leaves_ = {root};
     poses_.resize(1);
@@ -275,7 +283,7 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
     planWrites({0}, poses_);
     applyWrites({0}, {root});
     leaves_ = tree_.advance({root}, std::vector<int>(P, 0), ++generation_, map_);
-    poses_.assign(P, Pose2D());
+    poses_.assign(P, first);
     best_ = 0;
     last_neff_ = P;
     initialized_ = true;

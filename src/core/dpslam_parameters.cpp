@@ -53,6 +53,11 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
 
   // Map.
   positive(s, "map_resolution", c.map_resolution);
+  s.get("map_align_to_walls", c.map_align_to_walls);
+  if (s.get("map_wall_min_strength", c.map_wall_min_strength)) {
+    require(c.map_wall_min_strength >= 0.0 && c.map_wall_min_strength <= 1.0, "map_wall_min_strength",
+            c.map_wall_min_strength, "must be in [0, 1]");
+  }
   positive(s, "trace_max_range", c.trace_max_range);
   require(c.trace_max_range > c.map_resolution, "trace_max_range", c.trace_max_range, "must exceed map_resolution");
   positive(s, "no_return_range", c.no_return_range);
