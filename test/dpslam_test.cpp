@@ -74,13 +74,14 @@ struct LoopError {
 LoopError loopError(const DpSlam& slam) {
   const SimRun& run = loopRun();
   const Pose2D start = run.truth.front().pose;
+  const Pose2D frame = slam.bestLineagePath().front().pose;  // the first pose in the map frame
   const std::vector<StampedPose> traj = slam.bestTrajectory();
   LoopError e;
   for (std::size_t i = 0; i < traj.size(); ++i) {
-    const Pose2D t = between(start, run.truth[i].pose);
+    const Pose2D t = frame * between(start, run.truth[i].pose);
     e.max = std::max(e.max, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
   }
-  const Pose2D end_truth = between(start, run.truth.back().pose), end = slam.bestPose();
+  const Pose2D end_truth = frame * between(start, run.truth.back().pose), end = slam.bestPose();
   e.end = std::hypot(end.x - end_truth.x, end.y - end_truth.y);
   return e;
 }
@@ -92,7 +93,7 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   DpSlamConfig config;
   DpSlam slam(config);
   const FloorPlan room = test::furnishedRoom();
-  const Pose2D start = run.truth.front().pose;  // the map frame is the first base frame
+  const Pose2D start = run.truth.front().pose;
   std::vector<double> ms;
   std::size_t max_nodes = 0, max_entries = 0;
   for (std::size_t i = 0; i < run.scans.size(); ++i) {
@@ -106,8 +107,11 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
     max_nodes = std::max(max_nodes, u.tree_nodes);
     max_entries = std::max(max_entries, u.map_entries);
   }
-  // Pose error at the end and along the whole (final best) trajectory.
-  const Pose2D end_truth = between(start, run.truth.back().pose);
+  // Pose error at the end and along the whole (final best) trajectory, the truth carried onto the first
+  // pose (map_align_to_walls turns it).
+  const Pose2D frame = slam.bestLineagePath().front().pose;
+  const Pose2D end_truth = frame * between(start, run.truth.back().pose);
+  const Pose2D plan_from_map = start * frame.inverse();
   const Pose2D end = slam.bestPose();
   const double end_err = std::hypot(end.x - end_truth.x, end.y - end_truth.y);
   const double end_rot = std::abs(normalizeAngle(end.theta - end_truth.theta));
@@ -115,7 +119,7 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   ASSERT_EQ(traj.size(), run.scans.size());
   double max_err = 0.0;
   for (std::size_t i = 0; i < traj.size(); ++i) {
-    const Pose2D t = between(start, run.truth[i].pose);
+    const Pose2D t = frame * between(start, run.truth[i].pose);
     EXPECT_EQ(traj[i].stamp, run.scans[i].stamp);
     max_err = std::max(max_err, std::hypot(traj[i].pose.x - t.x, traj[i].pose.y - t.y));
   }
@@ -129,7 +133,7 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   double err_lineage = 0.0, err_out = 0.0, jitter_lineage = 0.0, jitter_out = 0.0;
   for (std::size_t i = 0; i < traj.size(); ++i) {
     EXPECT_EQ(lineage[i].stamp, traj[i].stamp);
-    const Pose2D t = between(start, run.truth[i].pose);
+    const Pose2D t = frame * between(start, run.truth[i].pose);
     err_lineage += std::pow(lineage[i].pose.x - t.x, 2) + std::pow(lineage[i].pose.y - t.y, 2);
     err_out += std::pow(traj[i].pose.x - t.x, 2) + std::pow(traj[i].pose.y - t.y, 2);
     if (i >= 2) {  // second differences of position: the scan-to-scan jitter
@@ -149,7 +153,7 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   ASSERT_GT(map.width, 0);
   int occupied = 0, on_wall = 0;
   auto plan_point = [&](int ix, int iy) {
-    return start.transform(Eigen::Vector2d(map.origin_x + (ix + 0.5) * map.resolution, map.origin_y + (iy + 0.5) * map.resolution));
+    return plan_from_map.transform(Eigen::Vector2d(map.origin_x + (ix + 0.5) * map.resolution, map.origin_y + (iy + 0.5) * map.resolution));
   };
   for (int iy = 0; iy < map.height; ++iy) {
     for (int ix = 0; ix < map.width; ++ix) {
@@ -161,7 +165,7 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   EXPECT_GT(occupied, 400);
   EXPECT_GT(on_wall, 0.97 * occupied) << on_wall << " of " << occupied << " occupied cells on the plan's walls";
   auto occupied_near = [&](double x, double y) {  // plan-frame point: an occupied map cell within 0.1 m?
-    const Eigen::Vector2d m = start.inverse().transform(Eigen::Vector2d(x, y));
+    const Eigen::Vector2d m = plan_from_map.inverse().transform(Eigen::Vector2d(x, y));
     const int cx = static_cast<int>(std::floor((m.x() - map.origin_x) / map.resolution));
     const int cy = static_cast<int>(std::floor((m.y() - map.origin_y) / map.resolution));
     for (int dy = -2; dy <= 2; ++dy) {
@@ -177,7 +181,7 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   for (double x = 1.1; x < 2.4; x += 0.2) EXPECT_TRUE(occupied_near(x, 4.9)) << "cabinet, x " << x;   // cabinet front
   for (double x = 2.0; x < 7.5; x += 0.5) EXPECT_TRUE(occupied_near(x, 0.1)) << "bottom wall, x " << x;
   // Free space where the robot drove, unknown far outside.
-  const Eigen::Vector2d inside = start.inverse().transform(Eigen::Vector2d(3.0, 3.0));
+  const Eigen::Vector2d inside = plan_from_map.inverse().transform(Eigen::Vector2d(3.0, 3.0));
   EXPECT_EQ(map.at(static_cast<int>((inside.x() - map.origin_x) / map.resolution),
                    static_cast<int>((inside.y() - map.origin_y) / map.resolution)), 0);
   std::sort(ms.begin(), ms.end());
@@ -308,7 +312,7 @@ TEST(DpSlam, UnusableScansMoveTheParticlesAndAreReported) {
   }
   // Every call left a pose, and the skipped ones did not derail the estimate.
   EXPECT_EQ(slam.bestTrajectory().size(), 120u);
-  const Pose2D t = between(run.truth.front().pose, run.truth[119].pose);
+  const Pose2D t = slam.bestLineagePath().front().pose * between(run.truth.front().pose, run.truth[119].pose);
   EXPECT_LT(std::hypot(slam.bestPose().x - t.x, slam.bestPose().y - t.y), 0.05);
   EXPECT_EQ(slam.particlePoses().size(), static_cast<std::size_t>(DpSlamConfig().particles));
 }
