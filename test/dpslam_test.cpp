@@ -545,6 +545,7 @@ TEST(DpSlam, MapAlignToWallsTurnsTheMapFrameToTheFirstScansWalls) {
     return Out{slam.bestTrajectory(), static_cast<double>(top) / std::max(occupied, 1)};
   };
   DpSlamConfig off, on, weak;
+  off.map_align_to_walls = false;
   on.map_align_to_walls = true;
   weak.map_align_to_walls = true;
   weak.map_wall_min_strength = 1.0;  // no real scan agrees that much: the first pose stays the frame

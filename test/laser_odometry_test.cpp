@@ -109,8 +109,10 @@ TEST(LaserOdometry, AlignToWallsMatchesAlongTheWallsAndReportsInTheOdomFrame) {
   EXPECT_LT(std::hypot(odom.pose().x - end_truth.x, odom.pose().y - end_truth.y), 0.15);
   EXPECT_LT(max_err, 0.15);
   EXPECT_LT(std::abs(normalizeAngle(odom.pose().theta - end_truth.theta)), 1.0 * M_PI / 180.0);
-  // Off (the default): the matching frame is the odom frame.
-  LaserOdometry plain;
+  // Off: the matching frame is the odom frame.
+  LaserOdometryConfig off;
+  off.align_to_walls = false;
+  LaserOdometry plain(off);
   plain.process(preprocessScan(run.scans[0], ScanPreprocessorConfig()), LaserMount());
   EXPECT_EQ(plain.frameAngle(), 0.0);
 }

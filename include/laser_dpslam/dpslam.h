@@ -57,7 +57,7 @@ struct DpSlamConfig {
   /// The map frame's axes run along the first scan's dominant wall direction (wall_direction.h, modulo 90°)
   /// instead of the first pose's heading: the grid's rows then lie along the walls, as they would on a plan,
   /// and the first pose is (0, 0, −that angle). Only when the chords agree at least map_wall_min_strength.
-  bool map_align_to_walls = false;
+  bool map_align_to_walls = true;
   double map_wall_min_strength = 0.3;  ///< [0, 1]
   double trace_max_range = 20.0;   ///< m; beams are traced this far at most, longer returns count as free space
   double no_return_range = 6.0;    ///< m; a no-return beam is free space up to min(this, the scan's range_max)

@@ -19,7 +19,7 @@ namespace laser_dpslam {
 struct ScanMatcherConfig {
   std::vector<double> cell_sizes{1.0, 0.5};  ///< m, NDT resolutions, coarse to fine; DE runs on the first
   NdtGridConfig ndt;                         ///< cell_size is overwritten by each of cell_sizes
-  double raster_resolution = 0.05;           ///< m, sample spacing of the DE score raster
+  double raster_resolution = 0.03;           ///< m, sample spacing of the DE score raster
 
   // Differential Evolution (algorithms.md §3).
   bool use_de = true;                 ///< false: Newton from the prior only (for comparison)
