@@ -397,11 +397,16 @@ TEST(DpSlam, ExploringShrinksTheProposalNoiseAndRevisitsRestoreIt) {
 }
 
 // revisit_freeze_map: on old ground the scans add only new cells, so the second lap adds far fewer map
-// entries than it does with the map updated everywhere, and the loop stays closed as tightly.
+// entries than it does with the map updated everywhere, and the loop stays closed as tightly. The count is
+// net of the ancestry tree's merging: in a map frame along the room's walls (map_align_to_walls, the default)
+// the updated second lap's count came out negative (−11974 entries against +42 frozen; presumably its
+// re-observations land on the first lap's very cells and the merging outweighs them), so the count compares
+// the two only in the first pose's frame.
 TEST(DpSlam, RevisitFreezeAddsOnlyNewCellsOnOldGround) {
   const SimRun& run = loopRun();
   auto secondLap = [&](bool freeze, LoopError* err) {
     DpSlamConfig config;
+    config.map_align_to_walls = false;
     config.revisit_freeze_map = freeze;
     DpSlam slam(config);
     std::size_t entries_at_half = 0, revisits = 0, entries_end = 0;

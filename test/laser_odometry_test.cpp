@@ -196,10 +196,15 @@ TEST(LaserOdometry, MountedLaserGivesTheBasePose) {
 // about 1 m (maps too short, the issue-4 failure). Smoothing the velocity (velocity_gain) at least halves it.
 // Measured with seeds 1-4 (final error, m): gain 1: 1.29, 0.97, 1.22, 0.79; gain 0.3: 0.45, 0.21, 0.42, 0.44.
 // Not fixed by it: starting from rest 2 m further south (the north wall 3.3 m away) stalls for seconds with
-// any gain.
+// any gain. The drive starts exactly parallel to the walls, which lie on the plan's 5 cm lattice: the case
+// where align_to_walls (on by default since the twenty-eighth session) costs, its frame being ~0.3° off the
+// walls (this corridor from rest, 10 starts shifted 0-5 cm: 0.154 m mean final error with it off, 0.273 m
+// on; the loop started a few degrees off the walls, as a real run is, gains from it: README "Tune"). The
+// smoothing is measured in the frame along the walls.
 TEST(LaserOdometry, SmoothedVelocityShrinksTheCorridorLag) {
   auto finalError = [](double gain, std::uint64_t seed) {
     LaserOdometryConfig c;
+    c.align_to_walls = false;
     c.velocity_gain = gain;
     c.degenerate_velocity_gain = -1.0;  // the same gain along the corridor (that one has its own test below)
     c.prior_release_speed = 0.0;        // and no prior release (its own test below)
@@ -314,17 +319,27 @@ TEST(LaserOdometry, PriorReleaseKeepsAStartFromRestInACorridor) {
 // Standing still where the corridor shows least (the loop building's west corridor south of its niche, 30 s,
 // seeds 1-3): the prior release must not fire on the scan noise. With prior_release_margin 0.004 it fired
 // twice with seed 3 and moved the estimate 0.124 m (0.078 m without the release); 0.005 keeps it out.
+// Standing exactly parallel to walls on the plan's lattice with align_to_walls on (the default), the frame is
+// ~0.3° off them and the release fires 3 times with seed 2 — without moving the estimate further than it
+// drifts with the release off (checked below); with the frame along the walls it must not fire at all.
 TEST(LaserOdometry, PriorReleaseDoesNotFireWhileStandingStill) {
   PathConfig path;
   path.start_pause = 30.0;
   std::vector<TimedPose> truth = samplePath({{1.95, 7.0}, {1.95, 2.0}}, 10.0, path);
   truth.erase(std::find_if(truth.begin(), truth.end(), [](const TimedPose& tp) { return tp.stamp > 30.0; }), truth.end());
   ASSERT_GE(truth.size(), 300u);
+  LaserOdometryConfig along;
+  along.align_to_walls = false;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     int released = 0;
-    loopBuildingFinalError(truth, LaserOdometryConfig(), seed,
+    loopBuildingFinalError(truth, along, seed,
                            [&](const TimedPose&, const OdometryUpdate& u) { released += u.match.prior_released ? 1 : 0; });
     EXPECT_EQ(released, 0) << "seed " << seed;
+    LaserOdometryConfig no_release;
+    no_release.prior_release_speed = 0.0;
+    const double with = loopBuildingFinalError(truth, LaserOdometryConfig(), seed),
+                 without = loopBuildingFinalError(truth, no_release, seed);
+    EXPECT_LE(with, without + 0.01) << "seed " << seed;
   }
 }
 
