@@ -53,6 +53,11 @@ struct LaserOdometryConfig {
   /// A short-range laser sees little along a corridor and the ripple dominates (CSAIL cut to 5.6 m: SLAM
   /// error −39 %); a long-range one sees far structure and real speed changes (full-range CSAIL: worse).
   double degenerate_velocity_max_range = 10.0;
+  /// s; > 0: for this long after the last match that fixed the position along every direction, a degenerate
+  /// match (same range gate) leaves the velocity along its weak direction as it was: the velocity measured
+  /// there carries the robot through a featureless stretch, where each match's small pull back towards the
+  /// local map would otherwise slow it down scan after scan. 0 = off.
+  double degenerate_hold_time = 10.0;
   /// m/s; > 0: while the estimated speed is below this, a degenerate (corridor) match may drop the motion
   /// prior when the scan fits clearly better without it (ScanMatcherConfig::prior_release_margin). Starting
   /// from rest in a corridor, the prior says "at rest" and the smoothed velocity catches up slowly: the
@@ -128,6 +133,7 @@ class LaserOdometry {
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  ///< base frame, per second
   std::deque<Keyframe> keyframes_;
+  double constrained_stamp_ = -1e300;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;
 };

@@ -48,6 +48,7 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
     require(o.degenerate_velocity_gain <= 1.0, "degenerate_velocity_gain", o.degenerate_velocity_gain, "must be <= 1");
   }
   nonNegative(s, "degenerate_velocity_max_range", o.degenerate_velocity_max_range);
+  nonNegative(s, "degenerate_hold_time", o.degenerate_hold_time);
   nonNegative(s, "prior_release_speed", o.prior_release_speed);
   nonNegative(s, "map_voxel", o.map_voxel);
   s.get("align_to_walls", o.align_to_walls);
