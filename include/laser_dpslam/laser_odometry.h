@@ -56,7 +56,8 @@ struct LaserOdometryConfig {
   /// s; > 0: for this long after the last match that fixed the position along every direction, a degenerate
   /// match (same range gate) leaves the velocity along its weak direction as it was: the velocity measured
   /// there carries the robot through a featureless stretch, where each match's small pull back towards the
-  /// local map would otherwise slow it down scan after scan. 0 = off.
+  /// local map would otherwise slow it down scan after scan. A released prior (prior_release_speed) ends the
+  /// hold: the scan refuted that velocity. 0 = off.
   double degenerate_hold_time = 10.0;
   /// m/s; > 0: while the estimated speed is below this, a degenerate (corridor) match may drop the motion
   /// prior when the scan fits clearly better without it (ScanMatcherConfig::prior_release_margin). Starting
