@@ -134,7 +134,8 @@ class LaserOdometry {
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  ///< base frame, per second
   std::deque<Keyframe> keyframes_;
-  double constrained_stamp_ = -1e300;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
+  static constexpr double kNoConstrainedMatch = -1e300;  ///< constrained_stamp_ when there is nothing to hold
+  double constrained_stamp_ = kNoConstrainedMatch;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;
 };

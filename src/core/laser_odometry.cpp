@@ -19,7 +19,7 @@ void LaserOdometry::reset() {
   keyframes_.clear();
   rng_.seed(config_.seed);
   scan_count_ = 0;
-  constrained_stamp_ = -1e300;
+  constrained_stamp_ = kNoConstrainedMatch;
 }
 
 void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points) {
@@ -198,7 +198,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
                              scan.range_max <= config_.degenerate_velocity_max_range;
     // A released prior was refuted by the scan: nothing left to hold.
-    if (u.match.prior_released) constrained_stamp_ = -1e300;
+    if (u.match.prior_released) constrained_stamp_ = kNoConstrainedMatch;
     const bool hold = config_.degenerate_hold_time > 0.0 && scan.stamp - constrained_stamp_ <= config_.degenerate_hold_time;
     if ((gw >= 0.0 || hold) && short_range && u.match.degenerate) {
       const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
@@ -207,7 +207,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     velocity_.z() = measured.z();
   } else {
     velocity_.setZero();
-    constrained_stamp_ = -1e300;  // nothing measured to hold
+    constrained_stamp_ = kNoConstrainedMatch;  // nothing measured to hold
   }
   if (!u.match.degenerate && !u.match.weak) constrained_stamp_ = scan.stamp;
   last_stamp_ = scan.stamp;
