@@ -47,6 +47,7 @@ const SimRun& loopRun() {
     odometry_config.match_range_margin = 0.0;
     odometry_config.degenerate_velocity_gain = -1.0;
     odometry_config.degenerate_hold_time = 0.0;
+    odometry_config.range_flow_gain = 0.0;
     LaserOdometry odom(odometry_config);
     for (const auto& tp : r.truth) {
       r.scans.push_back(preprocessScan(sim.simulate(tp.pose, 50.0 + tp.stamp), ScanPreprocessorConfig()));

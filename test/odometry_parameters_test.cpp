@@ -29,6 +29,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.degenerate_velocity_gain, d.degenerate_velocity_gain);
   EXPECT_EQ(o.degenerate_velocity_max_range, d.degenerate_velocity_max_range);
   EXPECT_EQ(o.degenerate_hold_time, d.degenerate_hold_time);
+  EXPECT_EQ(o.range_flow_gain, d.range_flow_gain);
   EXPECT_EQ(o.prior_release_speed, d.prior_release_speed);
   EXPECT_EQ(o.map_voxel, d.map_voxel);
   EXPECT_EQ(o.align_to_walls, d.align_to_walls);
@@ -98,6 +99,7 @@ TEST(OdometryParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("match_range_margin: -0.5").find("match_range_margin"), std::string::npos);
   EXPECT_NE(message("degenerate_velocity_gain: 2").find("degenerate_velocity_gain"), std::string::npos);
   EXPECT_NE(message("degenerate_hold_time: -1").find("degenerate_hold_time"), std::string::npos);
+  EXPECT_NE(message("range_flow_gain: 1.5").find("range_flow_gain"), std::string::npos);
   EXPECT_NE(message("prior_release_speed: -0.1").find("prior_release_speed"), std::string::npos);
   EXPECT_NE(message("angle_min: 1.0\nangle_max: 0.5").find("angle_min"), std::string::npos);
 }

@@ -11,6 +11,7 @@
 
 #include "laser_dpslam/laser_mount.h"
 #include "laser_dpslam/pose2d.h"
+#include "laser_dpslam/range_flow.h"
 #include "laser_dpslam/saliency_resampler.h"
 #include "laser_dpslam/scan_matcher.h"
 #include "laser_dpslam/scan_preprocessor.h"
@@ -59,6 +60,15 @@ struct LaserOdometryConfig {
   /// local map would otherwise slow it down scan after scan. A released prior (prior_release_speed) ends the
   /// hold: the scan refuted that velocity. 0 = off.
   double degenerate_hold_time = 10.0;
+  /// [0, 1]; > 0: where a degenerate match (same range gate) has lines in view that face along its weak
+  /// direction (a niche, a door frame, a pillar), the speed along that direction is also measured from how
+  /// their ranges changed since the previous scan (measureRangeFlow). When two consecutive flows agree and
+  /// their mean is more than 3σ + 0.02 m/s from the velocity, the velocity moves this fraction towards it,
+  /// instead of degenerate_velocity_gain or the hold: the local-map match cannot tell a robot that stopped
+  /// from one that drives on (with the hold the estimate drove on at the old speed), the previous scan can.
+  /// 0 = off.
+  double range_flow_gain = 0.3;
+  RangeFlowConfig range_flow;
   /// m/s; > 0: while the estimated speed is below this, a degenerate (corridor) match may drop the motion
   /// prior when the scan fits clearly better without it (ScanMatcherConfig::prior_release_margin). Starting
   /// from rest in a corridor, the prior says "at rest" and the smoothed velocity catches up slowly: the
@@ -91,6 +101,8 @@ struct OdometryUpdate {
   Eigen::Matrix3d delta_covariance = Eigen::Matrix3d::Identity();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< (vx, vy, ω) in the base frame
   MatchResult match;                  ///< its pose and weak_direction are in the matching frame (frameAngle())
+  RangeFlow range_flow;               ///< the speed along match.weak_direction from the range flow (range_flow_gain)
+  bool range_flow_applied = false;    ///< it (with the previous scan's) refuted the velocity and moved it
   bool new_keyframe = false;
   int points_used = 0;
 };
@@ -136,6 +148,9 @@ class LaserOdometry {
   std::deque<Keyframe> keyframes_;
   static constexpr double kNoConstrainedMatch = -1e300;  ///< constrained_stamp_ when there is nothing to hold
   double constrained_stamp_ = kNoConstrainedMatch;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
+  PreprocessedScan previous_scan_;  ///< the last scan matched (range_flow_gain)
+  RangeFlow last_flow_;              ///< the range flow measured with the last scan (invalid: none)
+  Eigen::Vector2d last_flow_direction_ = Eigen::Vector2d::Zero();  ///< its direction (the match's weak direction, matching frame)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;
 };

@@ -125,6 +125,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     pose_covariance_.setZero();
     velocity_.setZero();
     addKeyframe(base_points);
+    previous_scan_ = scan;
     u.ok = true;
     u.reset = true;
     u.new_keyframe = true;
@@ -162,6 +163,8 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   if (!u.match.valid) {
     u.skip_reason = "match_failed";
     pose_ = prior;
+    previous_scan_ = scan;
+    last_flow_ = RangeFlow();
     last_stamp_ = scan.stamp;
     u.pose = pose_;
     u.pose_covariance = pose_covariance_;
@@ -200,12 +203,37 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     // A released prior was refuted by the scan: nothing left to hold.
     if (u.match.prior_released) constrained_stamp_ = kNoConstrainedMatch;
     const bool hold = config_.degenerate_hold_time > 0.0 && scan.stamp - constrained_stamp_ <= config_.degenerate_hold_time;
-    if ((gw >= 0.0 || hold) && short_range && u.match.degenerate) {
+    if (short_range && u.match.degenerate) {
       const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
-      velocity_.head<2>() += weak * (((hold ? 0.0 : gw) - g) * weak.dot(measured.head<2>() - before));
+      if (config_.range_flow_gain > 0.0 && previous_scan_.stamp == last_stamp_) {
+        u.range_flow = measureRangeFlow(previous_scan_, scan, mount, u.delta, weak, dt, config_.range_flow);
+      }
+      const double before_w = weak.dot(before);
+      // Only two consecutive flows that agree, and together refute the velocity, move it: one scan's flow is
+      // noisier than the match's smoothed velocity (an edge, something moving: one flow can be far off) and a
+      // few per cent off near edges, so within 3σ of their mean (and 0.02 m/s) the velocity stays as the rules
+      // below make it. A robot that stops or starts in a corridor is far outside.
+      // (The last flow's direction is in the matching frame; a weak direction's sign is arbitrary.)
+      const double turn = last_flow_direction_.dot(u.match.weak_direction);
+      const RangeFlow& b = u.range_flow;
+      const double a_speed = turn < 0.0 ? -last_flow_.speed : last_flow_.speed;
+      const double mean = 0.5 * (a_speed + b.speed), sigma = 0.5 * std::hypot(last_flow_.sigma, b.sigma);
+      const bool refutes = last_flow_.valid && b.valid && std::abs(turn) > 0.99 &&
+                           std::abs(a_speed - b.speed) <= 3.0 * std::hypot(last_flow_.sigma, b.sigma) &&
+                           std::abs(mean - before_w) > 3.0 * sigma + 0.02;
+      u.range_flow_applied = refutes;
+      if (refutes) {
+        // The speed along the corridor measured against the previous scans, not the local map.
+        velocity_.head<2>() += weak * (before_w + config_.range_flow_gain * (mean - before_w) - weak.dot(velocity_.head<2>()));
+      } else if (gw >= 0.0 || hold) {
+        velocity_.head<2>() += weak * (((hold ? 0.0 : gw) - g) * weak.dot(measured.head<2>() - before));
+      }
     }
     velocity_.z() = measured.z();
+    last_flow_ = u.range_flow;
+    last_flow_direction_ = u.match.weak_direction;
   } else {
+    last_flow_ = RangeFlow();
     velocity_.setZero();
     constrained_stamp_ = kNoConstrainedMatch;  // nothing measured to hold
   }
@@ -221,6 +249,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     addKeyframe(base_points);
     u.new_keyframe = true;
   }
+  previous_scan_ = scan;
   u.ok = true;
   u.pose = pose_;
   u.pose_covariance = pose_covariance_;

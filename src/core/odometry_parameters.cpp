@@ -49,6 +49,9 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   }
   nonNegative(s, "degenerate_velocity_max_range", o.degenerate_velocity_max_range);
   nonNegative(s, "degenerate_hold_time", o.degenerate_hold_time);
+  if (s.get("range_flow_gain", o.range_flow_gain)) {
+    require(o.range_flow_gain >= 0.0 && o.range_flow_gain <= 1.0, "range_flow_gain", o.range_flow_gain, "must be in [0, 1]");
+  }
   nonNegative(s, "prior_release_speed", o.prior_release_speed);
   nonNegative(s, "map_voxel", o.map_voxel);
   s.get("align_to_walls", o.align_to_walls);

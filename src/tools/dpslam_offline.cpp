@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
 
   const bool show_progress = !args.quiet && ::isatty(STDOUT_FILENO);
   std::string slam_log = "stamp,ok,x,y,theta,sxx,syy,stt,neff,resampled,score_spread,revisit\n";
-  std::string match_log = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt,pxx,pyy,ptt\n";
+  std::string match_log = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt,pxx,pyy,ptt,flow_beams,flow_speed,flow_applied\n";
   LaserOdometry odometry(odom_config);
   // The offline refinement of the output path keeps a keyframe (its scan's points) every 0.2 m.
   const bool refine = !args.odometry_only && slam_config.refine_trajectory;
@@ -310,12 +310,14 @@ int main(int argc, char** argv) {
 
         if (!args.match_log.empty()) {
           char line[512];
-          std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g,%.4g,%.4g,%.4g\n",
+          std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g,%.4g,%.4g,%.4g,%d,%.4f,%d\n",
                         scan.stamp, u.ok, u.skip_reason.c_str(), u.pose.x, u.pose.y, u.pose.theta, u.delta.x, u.delta.y,
                         u.delta.theta, u.match.score_per_point, u.match.matched_fraction, u.match.degenerate, u.match.weak,
                         u.match.de_generations, u.match.de_evaluations, u.match.newton_iterations, u.points_used,
                         u.new_keyframe, ms, u.delta_covariance(0, 0), u.delta_covariance(1, 1), u.delta_covariance(2, 2),
-                        u.pose_covariance(0, 0), u.pose_covariance(1, 1), u.pose_covariance(2, 2));
+                        u.pose_covariance(0, 0), u.pose_covariance(1, 1), u.pose_covariance(2, 2),
+                        u.range_flow.valid ? u.range_flow.beams : 0, u.range_flow.valid ? u.range_flow.speed : 0.0,
+                        u.range_flow_applied ? 1 : 0);
           match_log += line;
         }
         // The odometry restarted by its own time check (compared with the last scan it used): same thing.
