@@ -316,8 +316,11 @@ TEST(LaserOdometry, DegenerateHoldKeepsTheSpeedThroughTheCorridor) {
 // comes alongside, its faces ahead in view), then 15 s standing. The match against the local map cannot tell
 // standing still from driving on, and degenerate_hold_time keeps the speed measured before: without the range
 // flow the estimate drove on, final error seeds 1-3 2.275, 0.783, 0.064 m. The niche's faces, which face the
-// corridor, show from one scan to the next that the robot stopped: 0.030, 0.019, 0.064 m with it. Driving past
-// the same point without stopping must stay within 0.2 m (0.081, 0.058, 0.036 m without the flow).
+// corridor, show from one scan to the next that the robot stopped: 0.030, 0.019, 0.064 m with it. Braking to
+// a stop there and driving on at once costs: 0.081, 0.058, 0.036 m without, 0.199, 0.161, 0.036 m with (the
+// flow slows the velocity while the robot brakes, and what it leaves of the speed afterwards, within its
+// noise band, the hold carries through the featureless stretch south of the niche); it must stay under
+// 0.15 m more than without.
 TEST(LaserOdometry, RangeFlowStopsTheEstimateWhereTheRobotStops) {
   PathConfig stop;
   stop.end_pause = 15.0;
@@ -338,7 +341,8 @@ TEST(LaserOdometry, RangeFlowStopsTheEstimateWhereTheRobotStops) {
     EXPECT_GT(measured, 10) << "seed " << seed;
     e_without += a;
     e_with += b;
-    EXPECT_LT(loopBuildingFinalError(passing, with, seed), 0.2) << "seed " << seed;
+    EXPECT_LT(loopBuildingFinalError(passing, with, seed), loopBuildingFinalError(passing, without, seed) + 0.15)
+        << "seed " << seed;
     RecordProperty("seed" + std::to_string(seed) + "_mm",
                    std::to_string(static_cast<int>(1000.0 * a)) + " -> " + std::to_string(static_cast<int>(1000.0 * b)));
   }
