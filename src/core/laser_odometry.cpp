@@ -126,6 +126,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     velocity_.setZero();
     addKeyframe(base_points);
     previous_scan_ = scan;
+    last_flow_ = RangeFlow();  // a flow from before a reset says nothing about this start
     u.ok = true;
     u.reset = true;
     u.new_keyframe = true;
