@@ -569,3 +569,16 @@ TEST(DpSlam, MapAlignToWallsTurnsTheMapFrameToTheFirstScansWalls) {
   EXPECT_NEAR(std::hypot(ra.x - rb.x, ra.y - rb.y), 0.0, 0.05);
   EXPECT_GT(out_on.on_lattice, out_off.on_lattice + 0.1);
 }
+
+// Either travel threshold works on its own: a distance alone ignores turns in place, an angle alone ignores
+// straight travel, and 0 for both updates at every scan.
+TEST(DpSlam, EitherTravelThresholdAloneWorks) {
+  EXPECT_TRUE(travelThresholdReached(Pose2D(0.01, 0.0, 0.0), 0.0, 0.0));
+  EXPECT_FALSE(travelThresholdReached(Pose2D(0.1, 0.0, 0.0), 0.2, 0.0));
+  EXPECT_FALSE(travelThresholdReached(Pose2D(0.0, 0.0, 1.0), 0.2, 0.0));
+  EXPECT_TRUE(travelThresholdReached(Pose2D(0.15, -0.15, 0.0), 0.2, 0.0));
+  EXPECT_FALSE(travelThresholdReached(Pose2D(0.1, 0.0, 0.2), 0.0, 0.3));
+  EXPECT_TRUE(travelThresholdReached(Pose2D(0.0, 0.0, -0.4), 0.0, 0.3));
+  EXPECT_TRUE(travelThresholdReached(Pose2D(0.3, 0.0, 0.0), 0.2, 0.3));
+  EXPECT_TRUE(travelThresholdReached(Pose2D(0.0, 0.0, 0.35), 0.2, 0.3));
+}

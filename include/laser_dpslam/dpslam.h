@@ -50,8 +50,8 @@ struct DpSlamConfig {
   /// along the ridge between them instead of stepping across (doc/experiments.md, twenty-third session).
   bool revisit_freeze_map = true;
   double revisit_min_travel = 10.0;  ///< m of travel after which a stretch of path counts as old (revisitable)
-  double min_travel_distance = 0.0;  ///< m; the filter updates once the robot moved this far ...
-  double min_travel_angle = 0.0;     ///< rad; ... or turned this much since its last update (0 and 0 = every scan)
+  double min_travel_distance = 0.0;  ///< m; the filter updates once the robot moved this far ... (0 = off)
+  double min_travel_angle = 0.0;     ///< rad; ... or turned this much since its last update (0 = off; both off = every scan)
   // --- Map ---
   double map_resolution = 0.05;    ///< m per cell
   /// The map frame's axes run along the first scan's dominant wall direction (wall_direction.h, modulo 90°)
@@ -64,8 +64,8 @@ struct DpSlamConfig {
   double entry_prior_cells = 4.0;  ///< cells of distance a new cell entry starts with (DP-SLAM's prior)
   int update_beam_step = 1;        ///< every k-th beam is written into the map
   double free_saturation_distance = 1.0;  ///< m; free cells seen without a hit over this distance are not rewritten (0 = off)
-  double map_update_distance = 0.0;  ///< m travelled since the last map update before the next ...
-  double map_update_angle = 0.0;     ///< rad turned since the last map update (0 and 0 = every filter update)
+  double map_update_distance = 0.0;  ///< m travelled since the last map update before the next ... (0 = off)
+  double map_update_angle = 0.0;     ///< rad turned since the last map update (0 = off; both off = every filter update)
   /// m; within this distance of a return (along its beam) distance through a cell is measured along the
   /// normal of the surface hit, in writes and scores alike (DpSlamMap::setSurfaceDepth; 0 = off)
   double surface_depth = 0.5;
@@ -121,6 +121,10 @@ struct DpSlamUpdate {
   std::size_t map_entries = 0;
   std::size_t memory_bytes = 0;  ///< map + caches
 };
+
+/// Whether `motion` (since the last update) reaches a travel threshold: `distance` metres or `angle` radians,
+/// each ignored when 0 (either alone works); with both 0, always.
+bool travelThresholdReached(const Pose2D& motion, double distance, double angle);
 
 class DpSlam {
  public:

@@ -10,6 +10,15 @@
 
 namespace laser_dpslam {
 
+bool travelThresholdReached(const Pose2D& motion, double distance, double angle) {
+  // A threshold of 0 is off: with a distance alone the robot's turns in place do not count, and the other
+  // way round (gmapping's linearUpdate / angularUpdate, each effective on its own).
+  if (distance <= 0.0 && angle <= 0.0) return true;
+  return (distance > 0.0 && std::hypot(motion.x, motion.y) >= distance) ||
+         (angle > 0.0 && std::abs(motion.theta) >= angle);
+}
+
+
 namespace {
 void require(bool ok, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("DpSlamConfig: ") + what);
@@ -295,9 +304,7 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
 
   compose(pending_, pending_cov_, delta, delta_cov);
   motion_ = motion_ * delta;
-  const bool moved_enough = (config_.min_travel_distance <= 0.0 && config_.min_travel_angle <= 0.0) ||
-                            std::hypot(pending_.x, pending_.y) >= config_.min_travel_distance ||
-                            std::abs(pending_.theta) >= config_.min_travel_angle;
+  const bool moved_enough = travelThresholdReached(pending_, config_.min_travel_distance, config_.min_travel_angle);
   if (!usable || !moved_enough) {
     // Not weighted: the particles carry the motion forward (and its uncertainty) until a usable scan.
     record(stamp);
@@ -381,9 +388,7 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
   //    update. Its descendants (all at that pose) see exactly what they would see had each written its own
   //    copy, without the copies.
   since_map_update_ = since_map_update_ * delta;
-  const bool due = (config_.map_update_distance <= 0.0 && config_.map_update_angle <= 0.0) ||
-                   std::hypot(since_map_update_.x, since_map_update_.y) >= config_.map_update_distance ||
-                   std::abs(since_map_update_.theta) >= config_.map_update_angle;
+  const bool due = travelThresholdReached(since_map_update_, config_.map_update_distance, config_.map_update_angle);
   std::vector<int> survivors;
   for (int i = 0; i < P; ++i) {
     if (std::find(parents.begin(), parents.end(), i) != parents.end()) survivors.push_back(i);
