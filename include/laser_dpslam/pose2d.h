@@ -54,4 +54,12 @@ struct Pose2D {
 /// The motion from a to b expressed in a's frame: a⁻¹ ⊕ b.
 inline Pose2D between(const Pose2D& a, const Pose2D& b) { return a.inverse() * b; }
 
+/// Jacobians of a ⊕ b with respect to a and b, for first-order propagation of pose covariances:
+/// Σ(a ⊕ b) ≈ Ja·Σa·Jaᵀ + Jb·Σb·Jbᵀ.
+inline void composeJacobians(const Pose2D& a, const Pose2D& b, Eigen::Matrix3d* Ja, Eigen::Matrix3d* Jb) {
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  *Ja << 1, 0, -s * b.x - c * b.y, 0, 1, c * b.x - s * b.y, 0, 0, 1;
+  *Jb << c, -s, 0, s, c, 0, 0, 0, 1;
+}
+
 }  // namespace laser_dpslam

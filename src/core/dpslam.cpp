@@ -26,14 +26,8 @@ void require(bool ok, const char* what) {
 
 /// a ⊕ b and the first-order covariance of the composition.
 void compose(Pose2D& a, Eigen::Matrix3d& cov_a, const Pose2D& b, const Eigen::Matrix3d& cov_b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  Eigen::Matrix3d ja = Eigen::Matrix3d::Identity(), jb = Eigen::Matrix3d::Identity();
-  ja(0, 2) = -s * b.x - c * b.y;
-  ja(1, 2) = c * b.x - s * b.y;
-  jb(0, 0) = c;
-  jb(0, 1) = -s;
-  jb(1, 0) = s;
-  jb(1, 1) = c;
+  Eigen::Matrix3d ja, jb;
+  composeJacobians(a, b, &ja, &jb);
   cov_a = ja * cov_a * ja.transpose() + jb * cov_b * jb.transpose();
   a = a * b;
 }

@@ -61,12 +61,6 @@ bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_point
   return true;
 }
 
-// Jacobians of a ⊕ b with respect to a and b.
-void composeJacobians(const Pose2D& a, const Pose2D& b, Eigen::Matrix3d* Ja, Eigen::Matrix3d* Jb) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  *Ja << 1, 0, -s * b.x - c * b.y, 0, 1, c * b.x - s * b.y, 0, 0, 1;
-  *Jb << c, -s, 0, s, c, 0, 0, 0, 1;
-}
 }  // namespace
 
 OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserMount& mount) {

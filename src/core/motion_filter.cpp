@@ -5,15 +5,6 @@
 
 namespace laser_dpslam {
 
-namespace {
-// Jacobians of a ⊕ b with respect to a and b.
-void composeJacobians(const Pose2D& a, const Pose2D& b, Eigen::Matrix3d* Ja, Eigen::Matrix3d* Jb) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  *Ja << 1, 0, -s * b.x - c * b.y, 0, 1, c * b.x - s * b.y, 0, 0, 1;
-  *Jb << c, -s, 0, s, c, 0, 0, 0, 1;
-}
-}  // namespace
-
 void MotionFilter::reset(const Pose2D& pose) {
   x_.setZero();
   x_.head<3>() = pose.vector();
