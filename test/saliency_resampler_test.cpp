@@ -1,4 +1,4 @@
-// Saliency-based resampling (saliency_resampler.h, algorithms.md §4) and the resampling facade.
+// Saliency-based resampling (saliency_resampler.h, doc/algorithms.md §4) and the resampling facade.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -57,7 +57,7 @@ LaserScan roomLaserScan(double noise_sigma, std::uint64_t seed = 7) {
   std::vector<Segment> segs;
   addBox(segs, -0.5, -1.8, 4.0, 1.8);
   addBox(segs, 0.3, -1.3, 0.9, -0.8);
-  LaserScan s;  // URG-04LX: 683 beams at 0.3516°, 0.02–5.6 m (algorithms.md §0)
+  LaserScan s;  // URG-04LX: 683 beams at 0.3516°, 0.02–5.6 m (doc/algorithms.md §0)
   s.angle_increment = 0.00613592315;
   s.angle_min = -341 * s.angle_increment;
   s.angle_max = 341 * s.angle_increment;

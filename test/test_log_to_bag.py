@@ -176,7 +176,7 @@ class LogToBagTest(unittest.TestCase):
     def test_dpslam(self):
         m = self.convert('dpslam', self.dpslam_text())
         scans = m['/scan']
-        # No time in these logs: 10 Hz from 0 (interfaces.md).
+        # No time in these logs: 10 Hz from 0 (the default --start-time).
         self.assertEqual([(s.header.stamp.secs, s.header.stamp.nsecs) for s in scans],
                          [(0, 0), (0, 100000000), (0, 200000000)])
         s = scans[0]

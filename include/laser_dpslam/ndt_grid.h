@@ -1,6 +1,6 @@
 // Normal Distributions Transform of a 2D point set (Biber & Straßer, IROS 2003): four overlapping
 // L×L grids shifted by L/2, a Gaussian per cell with ≥ min_points points, and the score h with its
-// analytic gradient and Hessian (algorithms.md §2).
+// analytic gradient and Hessian (doc/algorithms.md §2).
 #pragma once
 
 #include <Eigen/Core>
@@ -49,7 +49,7 @@ class NdtGrid {
   void build(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config);
 
   /// h at `pose` for `points` given in the moving frame; gradient and Hessian w.r.t. (x, y, θ) when
-  /// `derivatives` is set (Jacobian at the scan-frame point, algorithms.md §2).
+  /// `derivatives` is set (Jacobian at the scan-frame point, doc/algorithms.md §2).
   NdtScore score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points, bool derivatives) const;
 
   /// Σ over the four grids of exp(−½ qᵀΣ⁻¹q) for one point in the grid's frame (0 … 4).

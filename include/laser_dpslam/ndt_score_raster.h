@@ -1,5 +1,5 @@
 // A lookup raster of the NDT density: the cheap cost that Differential Evolution evaluates hundreds of
-// times per scan (algorithms.md §3: "consider a lookup raster of the score"). Bilinear interpolation
+// times per scan (doc/algorithms.md §3). Bilinear interpolation
 // between samples; the exact h (NdtGrid::score) is used afterwards for the Newton polish.
 #pragma once
 

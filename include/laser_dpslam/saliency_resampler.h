@@ -1,5 +1,5 @@
 // Saliency-based resampling: keep points at corners, occluding edges and rare surface orientations,
-// then fill the rest of the budget for spatial coverage (algorithms.md §4; the thesis's exact measure is
+// then fill the rest of the budget for spatial coverage (doc/algorithms.md §4; the thesis's exact measure is
 // not available, so this is the proposal there: 594 -> 134 points in the thesis's Fig. 83).
 #pragma once
 
@@ -12,7 +12,7 @@
 namespace laser_dpslam {
 
 struct SaliencyConfig {
-  // Segmentation (algorithms.md §4.2): consecutive points split when |Δρ| > jump_abs + jump_rel·min(ρ).
+  // Segmentation (doc/algorithms.md §4.2): consecutive points split when |Δρ| > jump_abs + jump_rel·min(ρ).
   double jump_abs = 0.1;   ///< m
   double jump_rel = 0.03;  ///< dimensionless, fraction of the nearer range
   int max_beam_gap = 3;    ///< beams; more invalid beams than this between two points also splits (no edge)
@@ -39,7 +39,7 @@ struct SaliencyConfig {
   double sampling_exponent = 2.0;  ///< dimensionless, sharpens the weights in weighted mode
 };
 
-/// What a point of a jump is (algorithms.md §4.2).
+/// What a point of a jump is (doc/algorithms.md §4.2).
 enum class EdgeType : std::uint8_t {
   kNone = 0,
   kOccluding = 1,  ///< near endpoint of a range jump: a real object boundary, salient

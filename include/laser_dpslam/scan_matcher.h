@@ -21,7 +21,7 @@ struct ScanMatcherConfig {
   NdtGridConfig ndt;                         ///< cell_size is overwritten by each of cell_sizes
   double raster_resolution = 0.03;           ///< m, sample spacing of the DE score raster
 
-  // Differential Evolution (algorithms.md §3).
+  // Differential Evolution (doc/algorithms.md §3).
   bool use_de = true;                 ///< false: Newton from the prior only (for comparison)
   int de_population = 20;             ///< NP
   int de_generations = 30;            ///< G, upper bound
@@ -34,7 +34,7 @@ struct ScanMatcherConfig {
   double de_spread_theta = 0.005;     ///< rad, … and this
   int de_stall_generations = 8;       ///< stop after this many generations without improvement
 
-  // Newton polish on h (algorithms.md §2).
+  // Newton polish on h (doc/algorithms.md §2).
   int newton_iterations = 10;         ///< per resolution
   double newton_tolerance = 1e-5;     ///< m / rad, step size at which Newton stops
 

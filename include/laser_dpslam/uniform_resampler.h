@@ -1,7 +1,7 @@
 // Spatially uniform and every-k-th point resampling of a preprocessed scan.
 //
 // Why: a low-cost LRF (URG-04LX) returns dense point clusters near the laser that dominate NDT cells;
-// the thesis resamples the scan uniformly in space before matching (594 -> 85 points, algorithms.md §0).
+// the thesis resamples the scan uniformly in space before matching (594 -> 85 points, doc/algorithms.md §0).
 #pragma once
 
 #include <cstddef>

@@ -60,7 +60,7 @@ void NdtGrid::build(const std::vector<Eigen::Vector2d>& points, const NdtGridCon
       NdtCell& c = layer.cells[i];
       c.count = a.n;
       c.mean = a.sum / a.n;
-      // Sample covariance (K − n·μμᵀ)/(n − 1): the minus sign matters (algorithms.md §2, known bug).
+      // Sample covariance (K − n·μμᵀ)/(n − 1): the minus sign matters (doc/algorithms.md §2, known bug).
       Eigen::Matrix2d cov = (a.sum_sq - a.n * c.mean * c.mean.transpose()) / (a.n - 1);
       // Regularise by rebuilding from the eigenvectors with a clamped smallest eigenvalue.
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;

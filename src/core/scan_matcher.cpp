@@ -50,7 +50,7 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
   NdtScore s = score(pose, &raw);
   int it = 0;
   for (; it < config_.newton_iterations; ++it) {
-    // Newton with the Hessian made positive definite (algorithms.md §2).
+    // Newton with the Hessian made positive definite (doc/algorithms.md §2).
     Eigen::Matrix3d H = s.hessian;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
     es.computeDirect(H, Eigen::EigenvaluesOnly);
@@ -102,7 +102,7 @@ bool ScanMatcher::degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* we
 }
 
 Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& r) const {
-  // Σ = α·H⁻¹ + Σ_min (algorithms.md §2 [P]): h is not a normalised likelihood, so H⁻¹ alone is
+  // Σ = α·H⁻¹ + Σ_min (doc/algorithms.md §2): h is not a normalised likelihood, so H⁻¹ alone is
   // over-confident. H's eigenvalues are floored so that a singular H still gives a finite (large) Σ.
   const Eigen::Matrix3d Hs = 0.5 * (hessian + hessian.transpose());
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
@@ -159,7 +159,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   r.pose = prior;
   if (!hasReference() || points.empty() || polish_points.empty()) return r;
 
-  // DE over a window around the prior (algorithms.md §3), the prior seeded into the population.
+  // DE over a window around the prior (doc/algorithms.md §3), the prior seeded into the population.
   auto deSearch = [&](const Eigen::Vector3d& w, std::mt19937_64& rng) {
     using DE = DifferentialEvolution<3>;
     DE::Config dc;

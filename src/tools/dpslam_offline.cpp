@@ -1,5 +1,5 @@
 // dpslam_offline: runs the laser odometry (and, without --odometry-only, the SLAM) on a bag as fast as
-// the CPU allows, without a ROS master. Interface: ../shared/docs/interfaces.md.
+// the CPU allows, without a ROS master. Usage: dpslam_offline --help.
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/LaserScan.h>
