@@ -11,4 +11,7 @@ namespace laser_dpslam {
 /// value is of the wrong type or out of its valid range.
 void readDpSlamParameters(const ParameterSource& source, DpSlamConfig& config);
 
+/// The keys dpslam_node reads itself (frames, publishing, TF, range limits), beside readDpSlamParameters's.
+const std::vector<std::string>& dpslamNodeKeys();
+
 }  // namespace laser_dpslam

@@ -13,4 +13,7 @@ namespace laser_dpslam {
 void readOdometryParameters(const ParameterSource& source, LaserOdometryConfig& odometry,
                             ScanPreprocessorConfig& preprocessing);
 
+/// The keys laser_odometry_node reads itself (frames, TF), beside readOdometryParameters's.
+const std::vector<std::string>& odometryNodeKeys();
+
 }  // namespace laser_dpslam

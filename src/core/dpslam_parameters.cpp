@@ -101,4 +101,11 @@ void readDpSlamParameters(const ParameterSource& s, DpSlamConfig& c) {
   atLeast(s, "threads", c.threads, 1);
 }
 
+const std::vector<std::string>& dpslamNodeKeys() {
+  static const std::vector<std::string> keys{"map_frame",         "odom_frame",        "base_frame",
+                                             "map_update_interval", "publish_particles", "transform_timeout",
+                                             "min_range",         "max_range"};
+  return keys;
+}
+
 }  // namespace laser_dpslam

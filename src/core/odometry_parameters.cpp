@@ -110,4 +110,9 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
   nonNegative(s, "prior_release_sigmas", m.prior_release_sigmas);
 }
 
+const std::vector<std::string>& odometryNodeKeys() {
+  static const std::vector<std::string> keys{"base_frame", "odom_frame", "publish_tf", "transform_timeout"};
+  return keys;
+}
+
 }  // namespace laser_dpslam

@@ -1,5 +1,6 @@
 #include "laser_dpslam/parameter_source.h"
 
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
 
@@ -32,12 +33,55 @@ bool YamlParameterSource::getScalar(const std::string& key, T& value, const char
   return true;
 }
 
-bool YamlParameterSource::get(const std::string& key, double& value) const { return getScalar(key, value, "a number"); }
-bool YamlParameterSource::get(const std::string& key, int& value) const { return getScalar(key, value, "an integer"); }
-bool YamlParameterSource::get(const std::string& key, bool& value) const { return getScalar(key, value, "true or false"); }
-bool YamlParameterSource::get(const std::string& key, std::string& value) const { return getScalar(key, value, "a string"); }
-bool YamlParameterSource::get(const std::string& key, std::vector<double>& value) const {
+bool YamlParameterSource::lookup(const std::string& key, double& value) const { return getScalar(key, value, "a number"); }
+bool YamlParameterSource::lookup(const std::string& key, int& value) const { return getScalar(key, value, "an integer"); }
+bool YamlParameterSource::lookup(const std::string& key, bool& value) const { return getScalar(key, value, "true or false"); }
+bool YamlParameterSource::lookup(const std::string& key, std::string& value) const { return getScalar(key, value, "a string"); }
+bool YamlParameterSource::lookup(const std::string& key, std::vector<double>& value) const {
   return getScalar(key, value, "a list of numbers");
+}
+
+std::vector<std::string> YamlParameterSource::keys() const {
+  std::vector<std::string> k;
+  if (!root_ || !root_.IsMap()) return k;
+  for (const auto& entry : root_) k.push_back(entry.first.as<std::string>());
+  return k;
+}
+
+int editDistance(const std::string& a, const std::string& b) {
+  std::vector<int> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    int diagonal = row[0];
+    row[0] = static_cast<int>(i);
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const int above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::vector<std::string> ParameterSource::unknownKeys() const {
+  std::vector<std::string> messages;
+  for (const std::string& key : keys()) {
+    if (known_.count(key)) continue;
+    std::string message = "unknown parameter '" + key + "' (ignored)";
+    // A suggestion only when it is close: a third of the name's letters at most, and at least two.
+    int best = std::max(2, static_cast<int>(key.size()) / 3) + 1;
+    std::string closest;
+    for (const std::string& k : known_) {
+      const int d = editDistance(key, k);
+      if (d < best) {
+        best = d;
+        closest = k;
+      }
+    }
+    if (!closest.empty()) message = "unknown parameter '" + key + "' (ignored): did you mean '" + closest + "'?";
+    messages.push_back(message);
+  }
+  return messages;
 }
 
 }  // namespace laser_dpslam

@@ -63,7 +63,10 @@ class DpSlamNode {
     pnh.param("transform_timeout", transform_timeout_, 0.2);
     pnh.param("min_range", pre_config_.min_range, 0.0);
     pnh.param("max_range", pre_config_.max_range, 0.0);
-    readDpSlamParameters(RosParameterSource(pnh), slam_config_);
+    const RosParameterSource source(pnh);
+    readDpSlamParameters(source, slam_config_);
+    source.markKnown(dpslamNodeKeys());
+    for (const std::string& m : source.unknownKeys()) ROS_WARN("dpslam_node: %s", m.c_str());
   }
 
   void onOdom(const nav_msgs::Odometry::ConstPtr& msg) {

@@ -39,7 +39,10 @@ class LaserOdometryNode {
     pnh.param("publish_tf", publish_tf_, true);
     pnh.param("transform_timeout", transform_timeout_, 0.2);
     try {
-      readOdometryParameters(RosParameterSource(pnh), odom_config_, pre_config_);
+      const RosParameterSource source(pnh);
+      readOdometryParameters(source, odom_config_, pre_config_);
+      source.markKnown(odometryNodeKeys());
+      for (const std::string& m : source.unknownKeys()) ROS_WARN("laser_odometry_node: %s", m.c_str());
     } catch (const std::exception& e) {
       ROS_FATAL("laser_odometry_node: %s", e.what());
       throw;

@@ -153,6 +153,10 @@ int main(int argc, char** argv) {
       const YamlParameterSource source = YamlParameterSource::load(path);
       readOdometryParameters(source, odom_config, pre_config);
       readDpSlamParameters(source, slam_config);
+      // The nodes' own keys belong in the same files (config/*.yaml): known, unused here.
+      source.markKnown(odometryNodeKeys());
+      source.markKnown(dpslamNodeKeys());
+      for (const std::string& m : source.unknownKeys()) std::cerr << "dpslam_offline: warning: " << path << ": " << m << "\n";
     }
     if (args.has_seed) {
       odom_config.seed = static_cast<std::uint64_t>(args.seed);

@@ -10,11 +10,15 @@ namespace laser_dpslam {
 class RosParameterSource : public ParameterSource {
  public:
   explicit RosParameterSource(const ros::NodeHandle& nh) : nh_(nh) {}
-  bool get(const std::string& key, double& value) const override;
-  bool get(const std::string& key, int& value) const override;
-  bool get(const std::string& key, bool& value) const override;
-  bool get(const std::string& key, std::string& value) const override;
-  bool get(const std::string& key, std::vector<double>& value) const override;
+  /// The parameters directly in the node handle's namespace.
+  std::vector<std::string> keys() const override;
+
+ protected:
+  bool lookup(const std::string& key, double& value) const override;
+  bool lookup(const std::string& key, int& value) const override;
+  bool lookup(const std::string& key, bool& value) const override;
+  bool lookup(const std::string& key, std::string& value) const override;
+  bool lookup(const std::string& key, std::vector<double>& value) const override;
 
  private:
   template <class T>
