@@ -25,6 +25,8 @@ class ParameterSource {
   void markKnown(const std::vector<std::string>& keys) const { known_.insert(keys.begin(), keys.end()); }
   /// The keys the source holds (top level).
   virtual std::vector<std::string> keys() const = 0;
+  /// The keys asked for or marked so far.
+  const std::set<std::string>& knownKeys() const { return known_; }
   /// One message per key the source holds that nobody asked for (a misspelt or retired parameter would
   /// otherwise be silently ignored), naming the closest known key when one is close.
   std::vector<std::string> unknownKeys() const;
