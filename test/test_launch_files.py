@@ -45,10 +45,15 @@ class LaunchFilesTest(unittest.TestCase):
     def test_robot_launch_turns_the_create_odometry_tf_off(self):
         c = load("robot.launch", "rviz:=false")
         n = nodes(c)
-        for name in ("urg_node", "ca_driver", "laser_mount_tf", "laser_odometry_node", "dpslam_node"):
+        for name in ("urg_node", "create_driver", "laser_mount_tf", "laser_odometry_node", "dpslam_node"):
             self.assertIn(name, n)
         self.assertNotIn("rviz", n)
-        self.assertIs(c.params["/ca_driver/publish_tf"].value, False)
+        self.assertIs(c.params["/create_driver/publish_tf"].value, False)
+        # create_autonomy's ROS 1 driver (package and node create_driver) and its parameter names.
+        self.assertEqual((n["create_driver"].package, n["create_driver"].type), ("create_driver", "create_driver"))
+        self.assertEqual(c.params["/create_driver/robot_model"].value, "CREATE_1")
+        self.assertEqual(c.params["/create_driver/dev"].value, "/dev/ttyUSB0")
+        self.assertIs(c.params["/urg_node/publish_intensity"].value, False)
         self.assertEqual(c.params["/urg_node/frame_id"].value, "laser")
         self.assertEqual(n["laser_mount_tf"].args.split()[-2:], ["base_link", "laser"])
 
