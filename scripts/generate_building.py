@@ -384,6 +384,10 @@ def generate(seed, family, out_dir, rng_range):
     rasterise(b, (th, ox, oy), out_dir)
     meta = {"seed": seed, "family": family, "angle_deg": math.degrees(th), "offset": [ox, oy],
             "route_m": sum(math.dist(a, e) for a, e in zip(route, route[1:])),
+            "ring_m": [round(lay.W, 2), round(lay.H, 2)],
+            "corridor_widths_m": {k: round(v, 2) for k, v in lay.width.items()},
+            "cross_corridors": len(lay.cross), "dead_end_m": round(lay.spur[1], 2) if lay.spur else None,
+            "hall_m": [round(lay.hall[1] - lay.hall[0], 2), round(lay.hall[2], 2)] if lay.hall else None,
             "walls": len(segs), "pillars": len(b.circles), "furniture": len(b.polygons),
             "blank_stretches_m": [round(v, 2) for v in blanks],
             "longest_blank_m": round(max(blanks, default=0.0), 2),

@@ -117,6 +117,24 @@ struct Options {
   WheelOdometryConfig wheels;
 };
 
+/// The wheel odometry's options with a value; false when `flag` is not one of them.
+bool parseWheelFlag(const std::string& flag, const std::string& value, Options* o) {
+  if (flag == "--wheel-rate") {
+    o->wheel_rate = parseDouble(flag, value);
+    if (!(o->wheel_rate > 0.0 && o->wheel_rate <= 1000.0)) throw UsageError("--wheel-rate must be in (0, 1000] Hz");
+  } else if (flag == "--wheel-scale-error") {
+    o->wheels.scale_error = parseDouble(flag, value);
+    if (!(o->wheels.scale_error >= 0.0 && o->wheels.scale_error < 0.5))
+      throw UsageError("--wheel-scale-error must be in [0, 0.5)");
+  } else if (flag == "--wheel-slip") {
+    o->wheels.slip = parseDouble(flag, value);
+    if (!(o->wheels.slip >= 0.0)) throw UsageError("--wheel-slip must be >= 0");
+  } else {
+    return false;
+  }
+  return true;
+}
+
 Options parseArgs(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
@@ -180,17 +198,7 @@ Options parseArgs(int argc, char** argv) {
     } else if (flag == "--robot-radius") {
       o.robot_radius = parseDouble(flag, value);
       if (!(o.robot_radius >= 0.0)) throw UsageError("--robot-radius must be >= 0");
-    } else if (flag == "--wheel-rate") {
-      o.wheel_rate = parseDouble(flag, value);
-      if (!(o.wheel_rate > 0.0 && o.wheel_rate <= 1000.0)) throw UsageError("--wheel-rate must be in (0, 1000] Hz");
-    } else if (flag == "--wheel-scale-error") {
-      o.wheels.scale_error = parseDouble(flag, value);
-      if (!(o.wheels.scale_error >= 0.0 && o.wheels.scale_error < 0.5))
-        throw UsageError("--wheel-scale-error must be in [0, 0.5)");
-    } else if (flag == "--wheel-slip") {
-      o.wheels.slip = parseDouble(flag, value);
-      if (!(o.wheels.slip >= 0.0)) throw UsageError("--wheel-slip must be >= 0");
-    } else {
+    } else if (!parseWheelFlag(flag, value, &o)) {
       throw UsageError("unknown option '" + flag + "'");
     }
   }
