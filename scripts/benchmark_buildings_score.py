@@ -51,7 +51,7 @@ def summary(mode, slam):
             ate.append(float(f[6]))
     inf = float("inf")
     for name, values, unit in (("drift %", drift, "%"), ("SLAM ATE", ate, "m")):
-        if not values and not failed:
+        if (unit == "m" and slam != "1") or (not values and not failed):
             continue
         values = values + [inf] * failed
         stats = (percentile(values, 50), percentile(values, 90), max(values))

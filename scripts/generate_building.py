@@ -299,6 +299,7 @@ def blank_intervals(a, b, feats, seg_a, seg_b, rng_range, step=0.25):
 def make_paths(rng, route, feats, seg_a, seg_b, rng_range):
     """The laser and wheel flavours of the route (lists of (x, y, pause, speed)) and the blank stretches."""
     laser, wheels, blanks = [], [], []
+    route = [p for k, p in enumerate(route) if k == 0 or math.dist(p, route[k - 1]) > 1e-6]
     for i, (a, b) in enumerate(zip(route, route[1:])):
         speed = rng.choice(SPEEDS)
         pause = rng.uniform(1.0, 5.0) if i > 0 and rng.random() < 0.3 else 0.0
