@@ -5,7 +5,7 @@
         prints "metres odometry-ATE drift-% SLAM-ATE" of one dpslam_offline run (evaluate_trajectory)
     benchmark_buildings_score.py summary MODE SLAM(0|1) < rows
         prints the median / 90th percentile / worst of the drift and the SLAM ATE over the rows, and whether
-        they meet the targets of that mode (laser: drift median <= 1 %, p90 <= 2 %, SLAM ATE median <= 0.05 m,
+        they meet the targets of that mode, and the medians per building family (laser: drift median <= 1 %, p90 <= 2 %, SLAM ATE median <= 0.05 m,
         worst <= 0.5 m; wheels: SLAM ATE median <= 0.03 m, worst <= 0.2 m). A failed run counts as worst.
 """
 import json
@@ -40,13 +40,14 @@ def percentile(v, q):
 
 
 def summary(mode, slam):
-    drift, ate, failed = [], [], 0
+    drift, ate, failed, families = [], [], 0, {}
     for line in sys.stdin:
         f = line.split()
         if len(f) < 7 or f[3] == "FAIL":
             failed += 1
             continue
         drift.append(float(f[5]))
+        families.setdefault(f[1], []).append((float(f[5]), float(f[6]) if slam == "1" else None))
         if slam == "1":
             ate.append(float(f[6]))
     inf = float("inf")
@@ -63,6 +64,11 @@ def summary(mode, slam):
         print("%-7s %-8s median %7.3f  p90 %7.3f  worst %7.3f  over %d runs%s   targets: %s" % (
             mode, name, stats[0], stats[1], stats[2], len(values), " (%d failed)" % failed if failed else "",
             ", ".join(verdict) or "none"))
+    if len(families) > 1:  # where the estimator loses: the median per family
+        print("%-7s by family (median drift %%%s): %s" % (mode, " / SLAM ATE m" if slam == "1" else "", ", ".join(
+            "%s %.2f%s" % (name, percentile([d for d, _ in v], 50),
+                           " / %.3f" % percentile([a for _, a in v], 50) if slam == "1" else "")
+            for name, v in sorted(families.items()))))
 
 
 if __name__ == "__main__":
