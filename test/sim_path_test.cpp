@@ -10,6 +10,8 @@
 namespace laser_dpslam {
 namespace {
 
+namespace fs = std::filesystem;
+
 const std::vector<Eigen::Vector2d> kWaypoints = {
     {1.0, 1.0}, {4.0, 1.0}, {4.0, 3.5}, {4.05, 3.5}, {1.0, 3.0}, {2.0, 2.0}, {1.0, 1.0}};
 
@@ -144,7 +146,6 @@ TEST(SimPath, LoopsRepeat) {
 }
 
 TEST(SimPath, WaypointFilesAndBuiltins) {
-  namespace fs = std::filesystem;
   std::string tmpl = (fs::temp_directory_path() / "sim_path_test_XXXXXX").string();
   ASSERT_NE(mkdtemp(tmpl.data()), nullptr);
   const fs::path dir(tmpl);
@@ -181,6 +182,77 @@ TEST(SimPath, ClearanceCheckFindsWalls) {
   EXPECT_EQ(checkPathClearance(plan, {{0.5, 1.8}, {1.5, 1.8}}, 0.2), "");
   EXPECT_NE(checkPathClearance(plan, {{0.5, 0.5}, {1.5, 0.5}}, 0.2), "");
   EXPECT_NE(checkPathClearance(plan, {{0.5, 1.8}, {1.5, 1.6}}, 0.2), "");
+}
+
+TEST(SimPath, WaypointPausesAndSegmentSpeeds) {
+  // Straight east: a 2 s dwell at the start, 0.2 m/s to the middle, 3 s stop there (no turn), 0.4 m/s on.
+  std::vector<Waypoint> wps(3);
+  wps[0].position = {0.0, 0.0};
+  wps[0].pause = 2.0;
+  wps[0].speed = 0.2;
+  wps[1].position = {3.0, 0.0};
+  wps[1].pause = 3.0;
+  wps[1].speed = 0.4;
+  wps[2].position = {7.0, 0.0};
+  const double rate = 50.0;
+  const std::vector<TimedPose> path = samplePath(wps, rate);
+  double max_v_first = 0.0, max_v_second = 0.0, still_at_middle = 0.0, still_at_start = 0.0;
+  for (const TimedPose& p : path) {
+    EXPECT_EQ(p.w, 0.0) << "turns at " << p.stamp;
+    if (p.pose.x < 3.0 - 1e-9) max_v_first = std::max(max_v_first, p.v);
+    if (p.pose.x > 3.0 + 1e-9) max_v_second = std::max(max_v_second, p.v);
+    if (p.v == 0.0 && std::abs(p.pose.x - 3.0) < 1e-9) still_at_middle += 1.0 / rate;
+    if (p.v == 0.0 && p.pose.x == 0.0) still_at_start += 1.0 / rate;
+  }
+  EXPECT_NEAR(max_v_first, 0.2, 1e-9);
+  EXPECT_NEAR(max_v_second, 0.4, 1e-9);
+  EXPECT_NEAR(still_at_middle, 3.0, 0.05);
+  EXPECT_NEAR(still_at_start, 2.0, 0.05);
+  // Accelerate / cruise / brake at 0.5 m/s² on each segment, plus the pauses.
+  const double expected = 2.0 + (3.0 / 0.2 + 0.2 / 0.5) + 3.0 + (4.0 / 0.4 + 0.4 / 0.5);
+  EXPECT_NEAR(pathDuration(wps), expected, 1e-9);
+  EXPECT_NEAR(path.back().pose.x, 7.0, 1e-12);
+
+  // Without pauses and speeds, the same path as the plain waypoints (byte-identical bags for old files).
+  const std::vector<Eigen::Vector2d> plain = positionsOf(wps);
+  const auto a = samplePath(plain, 10.0), b = samplePath(toWaypoints(plain), 10.0);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) EXPECT_EQ(a[k].pose.x, b[k].pose.x);
+
+  wps[1].speed = 0.6;  // above PathConfig::max_speed
+  EXPECT_THROW(samplePath(wps, rate), std::invalid_argument);
+  wps[1].speed = 0.3;
+  wps[1].pause = -1.0;
+  EXPECT_THROW(samplePath(wps, rate), std::invalid_argument);
+}
+
+TEST(SimPath, TimedWaypointFiles) {
+  const fs::path dir = fs::temp_directory_path() / "sim_path_timed_test";
+  fs::create_directories(dir);
+  std::ofstream(dir / "ok.txt") << "# x y pause speed\n0 0 1.5\n4 0 0 0.25  # stop\n4 3\n";
+  std::ofstream(dir / "five.txt") << "0 0\n1 1 1 1 1\n";
+  std::ofstream(dir / "negative.txt") << "0 0\n1 1 -2\n";
+  const std::vector<Waypoint> wps = loadTimedWaypoints((dir / "ok.txt").string());
+  ASSERT_EQ(wps.size(), 3u);
+  EXPECT_EQ(wps[0].pause, 1.5);
+  EXPECT_EQ(wps[0].speed, 0.0);
+  EXPECT_EQ(wps[1].speed, 0.25);
+  EXPECT_TRUE(wps[2].position.isApprox(Eigen::Vector2d(4.0, 3.0)));
+  for (const char* bad : {"five.txt:2", "negative.txt:2"}) {
+    const std::string file = std::string(bad).substr(0, std::string(bad).find(':'));
+    try {
+      loadTimedWaypoints((dir / file).string());
+      ADD_FAILURE() << "no exception for " << file;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+    }
+  }
+  // The plain loader still takes `x y` only.
+  EXPECT_THROW(loadWaypoints((dir / "ok.txt").string()), std::runtime_error);
+  const std::vector<Waypoint> laps = repeatLoop(wps, 2);
+  ASSERT_EQ(laps.size(), 7u);
+  EXPECT_EQ(laps[3].pause, 1.5);  // the closing waypoint is the first, with its dwell
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "laser_dpslam/floor_plan.h"
 #include "laser_dpslam/laser_scan.h"
 #include "laser_dpslam/pose2d.h"
+#include "laser_dpslam/vector_plan.h"
 
 namespace laser_dpslam {
 
@@ -37,14 +38,16 @@ struct ScanSimulatorConfig {
   void validate() const;
 };
 
-/// Simulates scans of the laser at a given map-frame pose. Walls are the occupied cells of the plan,
-/// hit exactly (see FloorPlan::raycast). All randomness comes from one std::mt19937_64 seeded in the
+/// Simulates scans of the laser at a given map-frame pose. Walls are the occupied cells of a raster plan,
+/// hit exactly (see FloorPlan::raycast), or the shapes of a geometry plan (VectorPlan::raycast). All randomness comes from one std::mt19937_64 seeded in the
 /// constructor, consumed in a fixed order (a fixed number of draws per beam), and turned into uniform
 /// and Gaussian variates by portable code: the same seed, plan, config and calls give identical scans
 /// on every platform. The scan is taken at one instant (no motion distortion within a sweep).
 class ScanSimulator {
  public:
   ScanSimulator(const FloorPlan& plan, const ScanSimulatorConfig& config, std::uint64_t seed);
+  /// On a geometry plan (walls at any angle; VectorPlan::raycast); the same noise model and draws.
+  ScanSimulator(const VectorPlan& plan, const ScanSimulatorConfig& config, std::uint64_t seed);
 
   /// One scan from `laser_pose_in_map` (the laser frame's pose in the plan's map frame), header stamp
   /// `stamp` [s]. ranges[i]: noisy distance [m], NaN for a dropout, +inf when no wall lies within
@@ -57,7 +60,8 @@ class ScanSimulator {
   double uniform();   ///< [0, 1) with 53 random bits
   double gaussian();  ///< standard normal (Box–Muller), consumes two uniforms
 
-  const FloorPlan& plan_;
+  const FloorPlan* grid_ = nullptr;      ///< one of the two plans is set
+  const VectorPlan* geometry_ = nullptr;
   ScanSimulatorConfig config_;
   std::mt19937_64 rng_;
 };

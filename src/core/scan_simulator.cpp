@@ -26,7 +26,12 @@ void ScanSimulatorConfig::validate() const {
 }
 
 ScanSimulator::ScanSimulator(const FloorPlan& plan, const ScanSimulatorConfig& config, std::uint64_t seed)
-    : plan_(plan), config_(config), rng_(seed) {
+    : grid_(&plan), config_(config), rng_(seed) {
+  config_.validate();
+}
+
+ScanSimulator::ScanSimulator(const VectorPlan& plan, const ScanSimulatorConfig& config, std::uint64_t seed)
+    : geometry_(&plan), config_(config), rng_(seed) {
   config_.validate();
 }
 
@@ -57,10 +62,20 @@ LaserScan ScanSimulator::simulate(const Pose2D& pose, double stamp) {
 
   const Eigen::Vector2d origin = pose.translation();
   const double cos_grazing = std::cos(c.grazing_angle);
+  // Only the shapes within range can be hit: casting against those keeps a big building cheap.
+  const VectorPlan local = geometry_ ? geometry_->near(origin, c.range_max) : VectorPlan();
   for (int i = 0; i < c.beams; ++i) {
     const double angle = pose.theta + c.angle_min + i * scan.angle_increment;
-    int axis = -1;
-    const double r = plan_.raycast(origin, angle, c.range_max, &axis);
+    double r = 0.0;
+    // Incidence: cosine of the angle between the beam and the normal of the surface it hit.
+    double cos_incidence = 1.0;
+    if (grid_) {
+      int axis = -1;
+      r = grid_->raycast(origin, angle, c.range_max, &axis);
+      cos_incidence = axis == 0 ? std::abs(std::cos(angle)) : (axis == 1 ? std::abs(std::sin(angle)) : 1.0);
+    } else {
+      r = local.raycast(origin, angle, c.range_max, &cos_incidence);
+    }
 
     // Fixed number of draws per beam, whatever happens to it: keeps the stream aligned.
     const double u_drop = uniform();
@@ -75,8 +90,6 @@ LaserScan ScanSimulator::simulate(const Pose2D& pose, double stamp) {
     } else if (!std::isfinite(r)) {
       out = kInf;
     } else {
-      // Incidence: cosine of the angle between the beam and the normal of the face it hit.
-      const double cos_incidence = axis == 0 ? std::abs(std::cos(angle)) : (axis == 1 ? std::abs(std::sin(angle)) : 1.0);
       if (cos_incidence < cos_grazing && u_graze < c.grazing_dropout_probability) {
         out = kNaN;
       } else if (u_outlier < c.outlier_probability && r > c.range_min) {

@@ -93,37 +93,48 @@ struct Primitive {
   }
 };
 
-std::vector<Eigen::Vector2d> distinctWaypoints(const std::vector<Eigen::Vector2d>& waypoints) {
-  std::vector<Eigen::Vector2d> out;
+std::vector<Waypoint> distinctWaypoints(const std::vector<Waypoint>& waypoints, const PathConfig& config) {
+  std::vector<Waypoint> out;
   for (const auto& w : waypoints) {
-    if (!w.allFinite()) throw std::invalid_argument("samplePath: waypoint with a non-finite coordinate");
-    if (out.empty() || (w - out.back()).norm() > 1e-9) out.push_back(w);
+    if (!w.position.allFinite()) throw std::invalid_argument("samplePath: waypoint with a non-finite coordinate");
+    if (!(w.pause >= 0.0) || !std::isfinite(w.pause)) throw std::invalid_argument("samplePath: pause must be >= 0");
+    if (!(w.speed >= 0.0) || w.speed > config.max_speed)
+      throw std::invalid_argument("samplePath: waypoint speed must be in (0, max_speed], or 0 for the default");
+    if (out.empty() || (w.position - out.back().position).norm() > 1e-9) {
+      out.push_back(w);
+    } else {  // a duplicate: one stop, its pauses added, the later speed
+      out.back().pause += w.pause;
+      out.back().speed = w.speed;
+    }
   }
   if (out.size() < 2) throw std::invalid_argument("samplePath: need at least two distinct waypoints");
   return out;
 }
 
-std::vector<Primitive> buildPrimitives(const std::vector<Eigen::Vector2d>& waypoints_in, const PathConfig& config) {
+std::vector<Primitive> buildPrimitives(const std::vector<Waypoint>& waypoints_in, const PathConfig& config) {
   config.validate();
-  const std::vector<Eigen::Vector2d> wps = distinctWaypoints(waypoints_in);
+  const std::vector<Waypoint> wps = distinctWaypoints(waypoints_in, config);
   std::vector<Primitive> prims;
   double t = 0.0;
-  const Eigen::Vector2d d0 = wps[1] - wps[0];
-  Pose2D pose(wps[0].x(), wps[0].y(), std::atan2(d0.y(), d0.x()));
+  const Eigen::Vector2d d0 = wps[1].position - wps[0].position;
+  Pose2D pose(wps[0].position.x(), wps[0].position.y(), std::atan2(d0.y(), d0.x()));
   auto push = [&](Primitive p) {
     p.t0 = t;
     p.start = pose;
     t += p.duration;
     prims.push_back(p);
   };
-  if (config.start_pause > 0.0) {
+  auto pause = [&](double seconds) {
+    if (!(seconds > 0.0)) return;
     Primitive p;
     p.kind = Primitive::kPause;
-    p.duration = config.start_pause;
+    p.duration = seconds;
     push(p);
-  }
+  };
+  pause(config.start_pause);
   for (std::size_t i = 0; i + 1 < wps.size(); ++i) {
-    const Eigen::Vector2d d = wps[i + 1] - wps[i];
+    pause(wps[i].pause);
+    const Eigen::Vector2d d = wps[i + 1].position - wps[i].position;
     const double heading = std::atan2(d.y(), d.x());
     const double turn = normalizeAngle(heading - pose.theta);
     if (std::abs(turn) > 1e-12) {
@@ -137,12 +148,14 @@ std::vector<Primitive> buildPrimitives(const std::vector<Eigen::Vector2d>& waypo
     pose.theta = heading;
     Primitive p;
     p.kind = Primitive::kDrive;
-    p.profile = Profile(d.norm(), config.cruise_speed, config.linear_acceleration);
+    const double speed = wps[i].speed > 0.0 ? wps[i].speed : config.cruise_speed;
+    p.profile = Profile(d.norm(), speed, config.linear_acceleration);
     p.duration = p.profile.duration();
     push(p);
-    pose.x = wps[i + 1].x();
-    pose.y = wps[i + 1].y();
+    pose.x = wps[i + 1].position.x();
+    pose.y = wps[i + 1].position.y();
   }
+  pause(wps.back().pause);
   Primitive end;
   end.kind = Primitive::kPause;
   end.duration = config.end_pause;
@@ -152,12 +165,34 @@ std::vector<Primitive> buildPrimitives(const std::vector<Eigen::Vector2d>& waypo
 
 }  // namespace
 
+std::vector<Waypoint> toWaypoints(const std::vector<Eigen::Vector2d>& positions) {
+  std::vector<Waypoint> out(positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) out[i].position = positions[i];
+  return out;
+}
+
+std::vector<Eigen::Vector2d> positionsOf(const std::vector<Waypoint>& waypoints) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(waypoints.size());
+  for (const auto& w : waypoints) out.push_back(w.position);
+  return out;
+}
+
 double pathDuration(const std::vector<Eigen::Vector2d>& waypoints, const PathConfig& config) {
+  return pathDuration(toWaypoints(waypoints), config);
+}
+
+std::vector<TimedPose> samplePath(const std::vector<Eigen::Vector2d>& waypoints, double rate_hz,
+                                  const PathConfig& config) {
+  return samplePath(toWaypoints(waypoints), rate_hz, config);
+}
+
+double pathDuration(const std::vector<Waypoint>& waypoints, const PathConfig& config) {
   const std::vector<Primitive> prims = buildPrimitives(waypoints, config);
   return prims.back().t0 + prims.back().duration;
 }
 
-std::vector<TimedPose> samplePath(const std::vector<Eigen::Vector2d>& waypoints, double rate_hz,
+std::vector<TimedPose> samplePath(const std::vector<Waypoint>& waypoints, double rate_hz,
                                   const PathConfig& config) {
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) throw std::invalid_argument("samplePath: rate_hz must be positive");
   const std::vector<Primitive> prims = buildPrimitives(waypoints, config);
@@ -177,10 +212,14 @@ std::vector<TimedPose> samplePath(const std::vector<Eigen::Vector2d>& waypoints,
   return out;
 }
 
-std::vector<Eigen::Vector2d> loadWaypoints(const std::string& path) {
+namespace {
+
+/// Parses a waypoint file whose lines hold min_fields to max_fields numbers; `expected` names the format.
+std::vector<std::vector<double>> loadNumberLines(const std::string& path, std::size_t min_fields,
+                                                 std::size_t max_fields, const std::string& expected) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open the waypoint file (missing or unreadable)");
-  std::vector<Eigen::Vector2d> out;
+  std::vector<std::vector<double>> out;
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {
@@ -192,21 +231,48 @@ std::vector<Eigen::Vector2d> loadWaypoints(const std::string& path) {
     for (std::string w; tokens >> w;) words.push_back(w);
     if (words.empty()) continue;
     auto fail = [&](const std::string& why) {
-      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": " + why + " (expected `x y` in metres)");
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": " + why + " (expected " + expected + ")");
     };
-    if (words.size() != 2) fail("expected 2 numbers, found " + std::to_string(words.size()) + " fields");
-    double xy[2];
-    for (int i = 0; i < 2; ++i) {
-      const char* s = words[static_cast<std::size_t>(i)].c_str();
+    if (words.size() < min_fields || words.size() > max_fields) {
+      const std::string n = min_fields == max_fields ? std::to_string(min_fields)
+                                                     : std::to_string(min_fields) + " to " + std::to_string(max_fields);
+      fail("expected " + n + " numbers, found " + std::to_string(words.size()) + " fields");
+    }
+    std::vector<double> values;
+    for (const std::string& word : words) {
+      const char* s = word.c_str();
       char* end = nullptr;
       errno = 0;
-      xy[i] = std::strtod(s, &end);
-      if (end == s || *end != '\0' || errno == ERANGE || !std::isfinite(xy[i])) fail("'" + words[static_cast<std::size_t>(i)] + "' is not a number");
+      const double v = std::strtod(s, &end);
+      if (end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) fail("'" + word + "' is not a number");
+      values.push_back(v);
     }
-    out.emplace_back(xy[0], xy[1]);
+    if (values.size() > 2 && values[2] < 0.0) fail("the pause must be >= 0 s");
+    if (values.size() > 3 && values[3] < 0.0) fail("the speed must be > 0 m/s (0: the default)");
+    out.push_back(values);
   }
   if (in.bad()) throw std::runtime_error(path + ": read error");
   if (out.size() < 2) throw std::runtime_error(path + ": needs at least two waypoints, found " + std::to_string(out.size()));
+  return out;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> loadWaypoints(const std::string& path) {
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& v : loadNumberLines(path, 2, 2, "`x y` in metres")) out.emplace_back(v[0], v[1]);
+  return out;
+}
+
+std::vector<Waypoint> loadTimedWaypoints(const std::string& path) {
+  std::vector<Waypoint> out;
+  for (const auto& v : loadNumberLines(path, 2, 4, "`x y [pause_s [speed_mps]]`")) {
+    Waypoint w;
+    w.position = Eigen::Vector2d(v[0], v[1]);
+    if (v.size() > 2) w.pause = v[2];
+    if (v.size() > 3) w.speed = v[3];
+    out.push_back(w);
+  }
   return out;
 }
 
@@ -224,6 +290,16 @@ std::vector<Eigen::Vector2d> repeatLoop(const std::vector<Eigen::Vector2d>& loop
   return out;
 }
 
+std::vector<Waypoint> repeatLoop(const std::vector<Waypoint>& loop, int laps) {
+  if (laps < 1) throw std::invalid_argument("repeatLoop: laps must be at least 1");
+  if (loop.size() < 2) throw std::invalid_argument("repeatLoop: need at least two waypoints");
+  std::vector<Waypoint> closed = loop;
+  if (!isClosedLoop(positionsOf(closed))) closed.push_back(loop.front());
+  std::vector<Waypoint> out = closed;
+  for (int lap = 1; lap < laps; ++lap) out.insert(out.end(), closed.begin() + 1, closed.end());
+  return out;
+}
+
 std::string builtinPathFile(const std::string& plan_yaml, const std::string& name) {
   const std::filesystem::path yaml(plan_yaml);
   return (yaml.parent_path() / (yaml.stem().string() + "_" + name + ".txt")).string();
@@ -231,7 +307,12 @@ std::string builtinPathFile(const std::string& plan_yaml, const std::string& nam
 
 std::string checkPathClearance(const FloorPlan& plan, const std::vector<Eigen::Vector2d>& waypoints,
                                double robot_radius) {
-  const double step = std::max(0.25 * plan.resolution(), 1e-3);
+  return checkPathClearance([&plan](const Eigen::Vector2d& p, double r) { return plan.clearance(p, r); },
+                            std::max(0.25 * plan.resolution(), 1e-3), waypoints, robot_radius);
+}
+
+std::string checkPathClearance(const std::function<double(const Eigen::Vector2d&, double)>& clearance,
+                               double step, const std::vector<Eigen::Vector2d>& waypoints, double robot_radius) {
   for (std::size_t i = 0; i < waypoints.size(); ++i) {
     const Eigen::Vector2d a = waypoints[i];
     const Eigen::Vector2d b = i + 1 < waypoints.size() ? waypoints[i + 1] : a;
@@ -239,7 +320,7 @@ std::string checkPathClearance(const FloorPlan& plan, const std::vector<Eigen::V
     const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
     for (int k = 0; k <= n; ++k) {
       const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(k) / n);
-      const double c = plan.clearance(p, robot_radius);
+      const double c = clearance(p, robot_radius);
       if (c < robot_radius) {
         std::ostringstream msg;
         msg.precision(3);

@@ -1,11 +1,13 @@
 // simulate_scans: a Hokuyo URG-04LX on an iRobot Create driving through a floor plan, written to a bag.
 //
-//   simulate_scans --floorplan PLAN.yaml --path {loop,explore,WAYPOINTS.txt} --out DIR [--seed N] [--duration S]
-//                  [--rate HZ] [--laps N] [--start-time S] [--laser-x M] [--laser-y M] [--laser-yaw RAD]
-//                  [--dropout P] [--outliers P] [--range-noise M]
+//   simulate_scans --floorplan {PLAN.yaml,PLAN.txt} --path {loop,explore,WAYPOINTS.txt} --out DIR [--seed N]
+//                  [--duration S] [--rate HZ] [--laps N] [--start-time S] [--laser-x M] [--laser-y M]
+//                  [--laser-yaw RAD] [--dropout P] [--outliers P] [--range-noise M]
 //                  [--range-noise-fraction F] [--no-noise] [--robot-radius M]
+//                  [--wheel-odometry] [--wheel-rate HZ] [--wheel-scale-error E] [--wheel-slip S]
 //
-// Writes DIR/sim.bag (/scan, /tf_static, /ground_truth) and DIR/ground_truth.tum. `--path loop` and
+// Writes DIR/sim.bag (/scan, /tf_static, /ground_truth, with --wheel-odometry /wheel_odom) and
+// DIR/ground_truth.tum. `--path loop` and
 // `--path explore` are the waypoint files next to the plan: PLAN_DIR/<plan stem>_loop.txt and
 // <plan stem>_explore.txt (e.g. plans/office.yaml → plans/office_loop.txt).
 #include <nav_msgs/Odometry.h>
@@ -20,6 +22,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -28,6 +31,8 @@
 #include "laser_dpslam/ros/msg_conversion.h"
 #include "laser_dpslam/scan_simulator.h"
 #include "laser_dpslam/sim_path.h"
+#include "laser_dpslam/vector_plan.h"
+#include "laser_dpslam/wheel_odometry_sim.h"
 
 namespace fs = std::filesystem;
 using namespace laser_dpslam;
@@ -35,18 +40,22 @@ using namespace laser_dpslam;
 namespace {
 
 const char* kUsage =
-    "usage: simulate_scans --floorplan PLAN.yaml --path {loop,explore,WAYPOINTS.txt} --out DIR\n"
+    "usage: simulate_scans --floorplan {PLAN.yaml,PLAN.txt} --path {loop,explore,WAYPOINTS.txt} --out DIR\n"
     "                      [--seed N] [--duration S] [options]\n"
     "\n"
     "Simulates a Hokuyo URG-04LX (683 beams, 240 deg, 0.02-5.6 m, 10 Hz, datasheet noise, dropouts as NaN,\n"
-    "no return as +inf) on an iRobot Create driving the waypoints through the floor plan (map_server YAML).\n"
+    "no return as +inf) on an iRobot Create driving the waypoints through the floor plan: a map_server YAML\n"
+    "(walls on its cell lattice) or a geometry plan PLAN.txt (walls, polygons and pillars at any angle, cast\n"
+    "exactly; format in doc/simulation.md).\n"
     "Writes DIR/sim.bag (/scan sensor_msgs/LaserScan frame 'laser'; /tf_static base_link->laser;\n"
     "/ground_truth nav_msgs/Odometry map->base_link) and DIR/ground_truth.tum (true base_link pose at every\n"
     "scan stamp: 'stamp x y z qx qy qz qw').\n"
     "\n"
     "  --path loop|explore  the built-in paths of the plan: <plan dir>/<plan stem>_loop.txt / _explore.txt\n"
-    "  --path FILE          waypoints, one 'x y' per line (metres, map frame), '#' comments; the robot starts\n"
-    "                       at the first facing the second and turns in place at each\n"
+    "  --path FILE          waypoints, one 'x y [pause_s [speed_mps]]' per line (metres, map frame), '#'\n"
+    "                       comments; the robot starts at rest at the first facing the second, stops and\n"
+    "                       turns in place at each, stands still pause_s there (default 0) and drives the\n"
+    "                       segment leaving it at speed_mps (default, or 0: 0.3 m/s; at most 0.5)\n"
     "  --seed N             random seed (default 1): same seed, same bag\n"
     "  --duration S         stop after S seconds; a closed loop is repeated as often as needed\n"
     "  --laps N             drive a closed loop N times (default 1)\n"
@@ -60,7 +69,16 @@ const char* kUsage =
     "  --range-noise-fraction F\n"
     "                       range noise per metre of range (default 0.01, the datasheet's 1 %)\n"
     "  --no-noise           exact ranges: no range noise, dropouts or outliers\n"
-    "  --robot-radius M     refuse paths closer than M to a wall (default 0.17, the Create's radius; 0: off)\n";
+    "  --robot-radius M     refuse paths closer than M to a wall (default 0.17, the Create's radius; 0: off)\n"
+    "  --wheel-odometry     also write Create-like wheel odometry: /wheel_odom nav_msgs/Odometry, frame 'odom'\n"
+    "                       (the first true pose) -> 'base_footprint' (= base_link, in /tf_static), pose\n"
+    "                       integrated from noisy left/right wheel travel (wheel base 0.258 m), twist in the\n"
+    "                       robot frame. Each wheel's travel is scaled by 1 + e, e drawn once per run uniform\n"
+    "                       in [-E, E] per wheel, plus slip noise S * sqrt(travel) * N(0,1) per step. Its own\n"
+    "                       random stream: the scans are the same with and without it\n"
+    "  --wheel-rate HZ      wheel odometry rate (default 20)\n"
+    "  --wheel-scale-error E  per-wheel scale error bound (default 0.01: 1 %)\n"
+    "  --wheel-slip S       slip noise in m per sqrt(m) of wheel travel (default 0.002)\n";
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -94,7 +112,28 @@ struct Options {
   double range_noise_fraction = ScanSimulatorConfig().noise_range_fraction;
   bool no_noise = false;
   double robot_radius = 0.17;
+  bool wheel_odometry = false;
+  double wheel_rate = 20.0;
+  WheelOdometryConfig wheels;
 };
+
+/// The wheel odometry's options with a value; false when `flag` is not one of them.
+bool parseWheelFlag(const std::string& flag, const std::string& value, Options* o) {
+  if (flag == "--wheel-rate") {
+    o->wheel_rate = parseDouble(flag, value);
+    if (!(o->wheel_rate > 0.0 && o->wheel_rate <= 1000.0)) throw UsageError("--wheel-rate must be in (0, 1000] Hz");
+  } else if (flag == "--wheel-scale-error") {
+    o->wheels.scale_error = parseDouble(flag, value);
+    if (!(o->wheels.scale_error >= 0.0 && o->wheels.scale_error < 0.5))
+      throw UsageError("--wheel-scale-error must be in [0, 0.5)");
+  } else if (flag == "--wheel-slip") {
+    o->wheels.slip = parseDouble(flag, value);
+    if (!(o->wheels.slip >= 0.0)) throw UsageError("--wheel-slip must be >= 0");
+  } else {
+    return false;
+  }
+  return true;
+}
 
 Options parseArgs(int argc, char** argv) {
   Options o;
@@ -106,6 +145,10 @@ Options parseArgs(int argc, char** argv) {
     }
     if (flag == "--no-noise") {
       o.no_noise = true;
+      continue;
+    }
+    if (flag == "--wheel-odometry") {
+      o.wheel_odometry = true;
       continue;
     }
     if (flag.rfind("--", 0) != 0) throw UsageError("unexpected argument '" + flag + "'");
@@ -155,7 +198,7 @@ Options parseArgs(int argc, char** argv) {
     } else if (flag == "--robot-radius") {
       o.robot_radius = parseDouble(flag, value);
       if (!(o.robot_radius >= 0.0)) throw UsageError("--robot-radius must be >= 0");
-    } else {
+    } else if (!parseWheelFlag(flag, value, &o)) {
       throw UsageError("unknown option '" + flag + "'");
     }
   }
@@ -165,16 +208,16 @@ Options parseArgs(int argc, char** argv) {
   return o;
 }
 
-std::vector<Eigen::Vector2d> resolveWaypoints(const Options& o) {
+std::vector<Waypoint> resolveWaypoints(const Options& o) {
   if (o.path == "loop" || o.path == "explore") {
     const std::string file = builtinPathFile(o.floorplan, o.path);
     if (!fs::exists(file)) {
       throw std::runtime_error("floor plan " + o.floorplan + " has no built-in '" + o.path + "' path (expected " +
                                file + "); pass a waypoint file with --path FILE");
     }
-    return loadWaypoints(file);
+    return loadTimedWaypoints(file);
   }
-  return loadWaypoints(o.path);
+  return loadTimedWaypoints(o.path);
 }
 
 boost::shared_ptr<ros::M_string> latchedHeader(const tf2_msgs::TFMessage& msg) {
@@ -187,37 +230,64 @@ boost::shared_ptr<ros::M_string> latchedHeader(const tf2_msgs::TFMessage& msg) {
   return h;
 }
 
-int run(const Options& o) {
-  const FloorPlan plan = FloorPlan::load(o.floorplan);
-  std::vector<Eigen::Vector2d> waypoints = resolveWaypoints(o);
-  const bool closed = isClosedLoop(waypoints);
+/// The plan: a map_server raster (.yaml/.yml) or a geometry plan (any other file).
+struct Plan {
+  std::optional<FloorPlan> grid;
+  std::optional<VectorPlan> geometry;
+
+  explicit Plan(const std::string& file) {
+    const std::string ext = fs::path(file).extension().string();
+    if (ext == ".yaml" || ext == ".yml") {
+      grid = FloorPlan::load(file);
+    } else {
+      geometry = VectorPlan::load(file);
+    }
+  }
+  std::string checkClearance(const std::vector<Eigen::Vector2d>& waypoints, double radius) const {
+    if (grid) return checkPathClearance(*grid, waypoints, radius);
+    const VectorPlan& g = *geometry;
+    return checkPathClearance([&g](const Eigen::Vector2d& p, double r) { return g.clearance(p, r); }, 0.01, waypoints,
+                              radius);
+  }
+};
+
+/// The waypoints as driven (laps, repeats for --duration), checked against the plan.
+std::vector<Waypoint> planWaypoints(const Options& o, const Plan& plan, const PathConfig& path_config) {
+  std::vector<Waypoint> waypoints = resolveWaypoints(o);
+  const bool closed = isClosedLoop(positionsOf(waypoints));
   if (o.laps > 1) {
     if (!closed) std::cerr << "simulate_scans: warning: the path is not a closed loop; --laps closes it\n";
     waypoints = repeatLoop(waypoints, o.laps);
   }
-
   if (o.robot_radius > 0.0) {
-    const std::string problem = checkPathClearance(plan, waypoints, o.robot_radius);
+    const std::string problem = plan.checkClearance(positionsOf(waypoints), o.robot_radius);
     if (!problem.empty()) throw std::runtime_error(o.path + ": " + problem);
   }
-
-  PathConfig path_config;
   if (o.duration > 0.0 && closed) {
     // Repeat the loop until it lasts at least --duration.
-    const std::vector<Eigen::Vector2d> one = waypoints;
+    const std::vector<Waypoint> one = waypoints;
     int laps = 1;
     while (pathDuration(waypoints, path_config) < o.duration && laps < 10000) waypoints = repeatLoop(one, ++laps);
   }
-  std::vector<TimedPose> path = samplePath(waypoints, o.rate, path_config);
+  return waypoints;
+}
+
+/// The path sampled at `rate`, cut at --duration.
+std::vector<TimedPose> sampleCut(const std::vector<Waypoint>& waypoints, double rate, const Options& o,
+                                 const PathConfig& path_config, bool warn) {
+  std::vector<TimedPose> path = samplePath(waypoints, rate, path_config);
   if (o.duration > 0.0) {
     const double last = path.back().stamp;
-    if (last < o.duration) {
+    if (warn && last < o.duration) {
       std::cerr << "simulate_scans: warning: the path ends after " << last << " s, before --duration " << o.duration
                 << " s (it is not a closed loop, so it is not repeated)\n";
     }
     while (!path.empty() && path.back().stamp > o.duration + 1e-9) path.pop_back();
   }
+  return path;
+}
 
+ScanSimulatorConfig sensorConfig(const Options& o) {
   ScanSimulatorConfig sensor;
   sensor.scan_rate = o.rate;
   sensor.dropout_probability = o.dropout;
@@ -231,7 +301,55 @@ int run(const Options& o) {
     sensor.grazing_dropout_probability = 0.0;
     sensor.outlier_probability = 0.0;
   }
-  ScanSimulator simulator(plan, sensor, o.seed);
+  return sensor;
+}
+
+/// /wheel_odom at --wheel-rate along the same path, stamped on the scans' clock, up to the last scan.
+void writeWheelOdometry(rosbag::Bag& bag, const Options& o, const std::vector<Waypoint>& waypoints,
+                        const PathConfig& path_config, double last_scan) {
+  const std::vector<TimedPose> path = sampleCut(waypoints, o.wheel_rate, o, path_config, false);
+  // A stream of its own, derived from the seed, so that the scans do not change with the option.
+  WheelOdometrySimulator wheels(o.wheels, o.seed * 0x9E3779B97F4A7C15ULL + 0x5EED);
+  std::printf("simulate_scans: wheel odometry scale errors: left %+.3f %%, right %+.3f %%\n",
+              100.0 * (wheels.leftScale() - 1.0), 100.0 * (wheels.rightScale() - 1.0));
+  std::uint32_t seq = 0;
+  for (const TimedPose& tp : path) {
+    if (tp.stamp > last_scan + 1e-9) break;
+    const WheelOdometryReading r = wheels.step(tp);
+    ros::Time t;
+    t.fromSec(o.start_time + tp.stamp);
+    nav_msgs::Odometry msg;
+    msg.header.stamp = t;
+    msg.header.seq = seq++;
+    msg.header.frame_id = "odom";
+    msg.child_frame_id = "base_footprint";
+    msg.pose.pose = toPoseMsg(r.pose);
+    msg.twist.twist.linear.x = r.v;
+    msg.twist.twist.angular.z = r.w;
+    // Variances: x, y and yaw grow with the distance driven (scale error and slip); z, roll and pitch
+    // are not measured (large, as drivers of planar robots publish them).
+    const double e = o.wheels.scale_error, slip2 = o.wheels.slip * o.wheels.slip, b = o.wheels.wheel_base;
+    const double var_xy = std::pow(e * r.distance, 2) + slip2 * r.distance + 1e-6;
+    const double var_yaw = 2.0 * (std::pow(e * r.distance, 2) + slip2 * r.distance) / (b * b) + 1e-6;
+    for (int i : {14, 21, 28}) msg.pose.covariance[i] = msg.twist.covariance[i] = 1e6;
+    msg.pose.covariance[0] = msg.pose.covariance[7] = var_xy;
+    msg.pose.covariance[35] = var_yaw;
+    const double dt = 1.0 / o.wheel_rate;
+    msg.twist.covariance[0] = msg.twist.covariance[7] = slip2 * 0.5 / dt + std::pow(e * r.v, 2) + 1e-6;
+    msg.twist.covariance[35] = 2.0 * (slip2 * 0.5 / dt + std::pow(e * r.v, 2)) / (b * b) + 1e-6;
+    bag.write("/wheel_odom", t, msg);
+  }
+}
+
+int run(const Options& o) {
+  const Plan plan(o.floorplan);
+  const PathConfig path_config;
+  const std::vector<Waypoint> waypoints = planWaypoints(o, plan, path_config);
+  const std::vector<TimedPose> path = sampleCut(waypoints, o.rate, o, path_config, true);
+
+  const ScanSimulatorConfig sensor = sensorConfig(o);
+  ScanSimulator simulator = plan.grid ? ScanSimulator(*plan.grid, sensor, o.seed)
+                                      : ScanSimulator(*plan.geometry, sensor, o.seed);
 
   fs::create_directories(o.out);
   const std::string bag_path = (fs::path(o.out) / "sim.bag").string();
@@ -257,6 +375,13 @@ int run(const Options& o) {
       mount.child_frame_id = sensor.frame_id;
       mount.transform = toTransformMsg(o.laser_mount);
       tf.transforms.push_back(mount);
+      if (o.wheel_odometry) {  // the wheel odometry's child frame, as the Create's description has it
+        geometry_msgs::TransformStamped footprint = mount;
+        footprint.header.frame_id = "base_footprint";
+        footprint.child_frame_id = "base_link";
+        footprint.transform = toTransformMsg(Pose2D());
+        tf.transforms.push_back(footprint);
+      }
       bag.write("/tf_static", t, tf, latchedHeader(tf));
     } else {
       length += (tp.pose.translation() - path[k - 1].pose.translation()).norm();
@@ -282,6 +407,7 @@ int run(const Options& o) {
     std::fprintf(tum, "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", t.toSec(), tp.pose.x, tp.pose.y, 0.0, q.x, q.y,
                  q.z, q.w);
   }
+  if (o.wheel_odometry && !path.empty()) writeWheelOdometry(bag, o, waypoints, path_config, path.back().stamp);
   bag.close();
   if (std::fclose(tum) != 0) throw std::runtime_error(tum_path + ": write error");
 

@@ -1,0 +1,86 @@
+"""scripts/generate_building.py and simulate_scans on its plans: the same seed gives the same building;
+the plan is a geometry plan simulate_scans reads; the laser path keeps its stops where something is in
+view while the wheel path also stops in blank stretches; --wheel-odometry adds /wheel_odom without
+changing the scans."""
+import filecmp
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import rosbag
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # nosetests under catkin does not add it
+from test_demo_run import PKG  # noqa: E402
+
+GENERATOR = os.path.join(PKG, "scripts", "generate_building.py")
+
+
+def generate(seed, out, family=None):
+    cmd = ["/usr/bin/python3", GENERATOR, "--seed", str(seed), "--out", out] + (["--family", family] if family else [])
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    return json.loads(run.stdout)
+
+
+def waypoints(path):
+    return [l.split() for l in open(path) if l.strip() and not l.startswith("#")]
+
+
+class GenerateBuildingTest(unittest.TestCase):
+    def test_same_seed_same_building(self):
+        a, b, c = (tempfile.mkdtemp() for _ in range(3))
+        generate(5, a)
+        generate(5, b)
+        generate(6, c)
+        for f in ("plan.txt", "plan.pgm", "plan.yaml", "path_laser.txt", "path_wheels.txt", "meta.json"):
+            self.assertTrue(filecmp.cmp(os.path.join(a, f), os.path.join(b, f), shallow=False), f)
+        self.assertFalse(filecmp.cmp(os.path.join(a, "plan.txt"), os.path.join(c, "plan.txt"), shallow=False))
+
+    def test_blank_family_has_long_blank_stretches_and_wheel_stops_there(self):
+        for seed in (4, 9, 14):
+            out = tempfile.mkdtemp()
+            meta = generate(seed, out, "blank")
+            self.assertGreater(meta["longest_blank_m"], 0.5, meta)
+            self.assertGreaterEqual(meta["wheel_stops_in_corridors"], 1, meta)
+            self.assertGreaterEqual(meta["route_m"], 80.0)
+            laser, wheels = waypoints(os.path.join(out, "path_laser.txt")), waypoints(os.path.join(out, "path_wheels.txt"))
+            self.assertGreater(len(wheels), len(laser))
+            # The building is turned off the axes: not every wall is horizontal or vertical.
+            walls = [list(map(float, l.split()[1:])) for l in open(os.path.join(out, "plan.txt")) if l.startswith("wall")]
+            self.assertTrue(any(min(abs(w[2] - w[0]), abs(w[3] - w[1])) > 0.01 for w in walls))
+
+    def test_simulated_with_wheel_odometry(self):
+        out = tempfile.mkdtemp()
+        generate(2, out)  # a hall: pillars and furniture
+        bags = {}
+        for name, extra in (("plain", []), ("wheels", ["--wheel-odometry"])):
+            run = subprocess.run(["rosrun", "laser_dpslam", "simulate_scans", "--floorplan", os.path.join(out, "plan.txt"),
+                                  "--path", os.path.join(out, "path_wheels.txt"), "--duration", "30", "--seed", "2",
+                                  "--out", os.path.join(out, name)] + extra, capture_output=True, text=True)
+            self.assertEqual(run.returncode, 0, run.stderr)
+            with rosbag.Bag(os.path.join(out, name, "sim.bag")) as bag:
+                bags[name] = {t: [m for _, m, _ in bag.read_messages(topics=[t])] for t in ("/scan", "/wheel_odom")}
+        self.assertEqual(len(bags["plain"]["/wheel_odom"]), 0)
+        scans = {k: [repr(list(m.ranges)) for m in v["/scan"]] for k, v in bags.items()}  # repr: NaN == NaN
+        self.assertEqual(scans["plain"], scans["wheels"])
+        odom = bags["wheels"]["/wheel_odom"]
+        self.assertGreater(len(odom), 500)  # 20 Hz over 30 s
+        self.assertEqual((odom[0].header.frame_id, odom[0].child_frame_id), ("odom", "base_footprint"))
+        self.assertEqual(odom[0].pose.pose.position.x, 0.0)
+        self.assertGreater(max(m.twist.twist.linear.x for m in odom), 0.1)
+        # Bad plan lines are reported with file and line.
+        bad = os.path.join(out, "bad.txt")
+        with open(bad, "w") as f:
+            f.write("wall 0 0 5 0\nwall 0 1 five 1\n")
+        run = subprocess.run(["rosrun", "laser_dpslam", "simulate_scans", "--floorplan", bad, "--path",
+                              os.path.join(out, "path_laser.txt"), "--out", os.path.join(out, "bad")],
+                             capture_output=True, text=True)
+        self.assertEqual(run.returncode, 1)
+        self.assertIn("bad.txt:2: 'five' is not a number", run.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
