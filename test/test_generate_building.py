@@ -68,7 +68,7 @@ class GenerateBuildingTest(unittest.TestCase):
         self.assertEqual(scans["plain"], scans["wheels"])
         odom = bags["wheels"]["/wheel_odom"]
         self.assertGreater(len(odom), 500)  # 20 Hz over 30 s
-        self.assertEqual((odom[0].header.frame_id, odom[0].child_frame_id), ("odom", "base_footprint"))
+        self.assertEqual((odom[0].header.frame_id, odom[0].child_frame_id), ("odom", "base_link"))
         self.assertEqual(odom[0].pose.pose.position.x, 0.0)
         self.assertGreater(max(m.twist.twist.linear.x for m in odom), 0.1)
         # Bad plan lines are reported with file and line.

@@ -71,7 +71,7 @@ const char* kUsage =
     "  --no-noise           exact ranges: no range noise, dropouts or outliers\n"
     "  --robot-radius M     refuse paths closer than M to a wall (default 0.17, the Create's radius; 0: off)\n"
     "  --wheel-odometry     also write Create-like wheel odometry: /wheel_odom nav_msgs/Odometry, frame 'odom'\n"
-    "                       (the first true pose) -> 'base_footprint' (= base_link, in /tf_static), pose\n"
+    "                       (the first true pose) -> 'base_link' (no TF: the laser odometry owns it), pose\n"
     "                       integrated from noisy left/right wheel travel (wheel base 0.258 m), twist in the\n"
     "                       robot frame. Each wheel's travel is scaled by 1 + e, e drawn once per run uniform\n"
     "                       in [-E, E] per wheel, plus slip noise S * sqrt(travel) * N(0,1) per step. Its own\n"
@@ -322,7 +322,7 @@ void writeWheelOdometry(rosbag::Bag& bag, const Options& o, const std::vector<Wa
     msg.header.stamp = t;
     msg.header.seq = seq++;
     msg.header.frame_id = "odom";
-    msg.child_frame_id = "base_footprint";
+    msg.child_frame_id = "base_link";
     msg.pose.pose = toPoseMsg(r.pose);
     msg.twist.twist.linear.x = r.v;
     msg.twist.twist.angular.z = r.w;
@@ -375,13 +375,6 @@ int run(const Options& o) {
       mount.child_frame_id = sensor.frame_id;
       mount.transform = toTransformMsg(o.laser_mount);
       tf.transforms.push_back(mount);
-      if (o.wheel_odometry) {  // the wheel odometry's child frame, as the Create's description has it
-        geometry_msgs::TransformStamped footprint = mount;
-        footprint.header.frame_id = "base_footprint";
-        footprint.child_frame_id = "base_link";
-        footprint.transform = toTransformMsg(Pose2D());
-        tf.transforms.push_back(footprint);
-      }
       bag.write("/tf_static", t, tf, latchedHeader(tf));
     } else {
       length += (tp.pose.translation() - path[k - 1].pose.translation()).norm();
