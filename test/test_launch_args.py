@@ -68,7 +68,7 @@ class LaunchArgsTest(unittest.TestCase):
             self.assertTrue(roslib.packages.find_node("laser_dpslam", node.type), "%s not built" % node.type)
 
     def test_executables_of_installed_packages_exist(self):
-        # Packages that are absent (urg_node, ca_driver, maybe rviz) are the user's to install; but a package
+        # Packages that are absent (urg_node, create_driver, maybe rviz) are the user's to install; but a package
         # that is there without its executable fails only at run time, e.g. Debian's tf2_ros without
         # tf2-tools, which ships static_transform_publisher.
         rospack = rospkg.RosPack()
@@ -92,7 +92,7 @@ class LaunchArgsTest(unittest.TestCase):
         self.assertEqual(p["/laser_odometry_node/odom_frame"].value, "odom2")
         self.assertEqual(p["/dpslam_node/odom_frame"].value, "odom2")
         self.assertEqual(p["/dpslam_node/map_frame"].value, "world")
-        self.assertEqual(p["/ca_driver/base_frame"].value, "base_footprint")
+        self.assertEqual(p["/create_driver/base_frame"].value, "base_footprint")
         self.assertEqual(p["/urg_node/frame_id"].value, "hokuyo")
         self.assertEqual(remaps(n["urg_node"]).get("scan"), "base_scan")
         self.assertEqual(remaps(n["laser_odometry_node"]).get("scan"), "base_scan")
@@ -102,7 +102,14 @@ class LaunchArgsTest(unittest.TestCase):
 
     def test_robot_launch_keeps_wheel_odometry_out_of_the_way(self):
         n = nodes(load("robot.launch"))
-        self.assertEqual(remaps(n["ca_driver"]).get("odom"), "wheel_odom")
+        self.assertEqual(remaps(n["create_driver"]).get("odom"), "wheel_odom")
+        # create_autonomy's current package, node and parameter names (ca_driver was its old name).
+        self.assertEqual((n["create_driver"].package, n["create_driver"].type), ("create_driver", "create_driver"))
+        p = load("robot.launch", "create_port:=/dev/ttyUSB7").params
+        self.assertEqual(p["/create_driver/dev"].value, "/dev/ttyUSB7")
+        self.assertEqual(p["/create_driver/robot_model"].value, "CREATE_1")
+        self.assertEqual(p["/create_driver/odom_frame"].value, "odom")
+        self.assertEqual(p["/urg_node/serial_port"].value, "/dev/ttyACM0")
         self.assertEqual(len(n["laser_mount_tf"].args.split()), 8)  # x y z yaw pitch roll parent child
 
     def test_urg_field_of_view_arguments(self):

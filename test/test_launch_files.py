@@ -45,10 +45,10 @@ class LaunchFilesTest(unittest.TestCase):
     def test_robot_launch_turns_the_create_odometry_tf_off(self):
         c = load("robot.launch", "rviz:=false")
         n = nodes(c)
-        for name in ("urg_node", "ca_driver", "laser_mount_tf", "laser_odometry_node", "dpslam_node"):
+        for name in ("urg_node", "create_driver", "laser_mount_tf", "laser_odometry_node", "dpslam_node"):
             self.assertIn(name, n)
         self.assertNotIn("rviz", n)
-        self.assertIs(c.params["/ca_driver/publish_tf"].value, False)
+        self.assertIs(c.params["/create_driver/publish_tf"].value, False)
         self.assertEqual(c.params["/urg_node/frame_id"].value, "laser")
         self.assertEqual(n["laser_mount_tf"].args.split()[-2:], ["base_link", "laser"])
 

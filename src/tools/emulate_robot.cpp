@@ -69,6 +69,7 @@ Options parseArgs(int argc, char** argv) {
     const std::string flag = argv[i];
     if (flag == "-h" || flag == "--help") { std::cout << kUsage; std::exit(0); }
     if (flag == "--no-noise") { o.no_noise = true; continue; }
+    if (flag.rfind("__", 0) == 0 && flag.find(":=") != std::string::npos) continue;  // roslaunch's __name:= etc.
     if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
     const std::string v = argv[++i];
     if (flag == "--floorplan") o.floorplan = v;
