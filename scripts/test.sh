@@ -3,6 +3,15 @@
 # catkin summary, copy the JUnit XML to out/test_results/, exit non-zero on any failure.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
+# The robot drivers (urg_node, create_driver) for test/robot_drivers.test: built once from the source
+# snapshots, cached outside the repository; without the sources that test reports itself skipped.
+drivers_status=0
+"$REPO/scripts/build_drivers.sh" > "$WS/drivers.log" 2>&1 || drivers_status=$?
+case $drivers_status in
+  0) echo "[laser_dpslam] robot drivers: $(tail -n 1 "$WS/drivers.log")" ;;
+  3) echo "[laser_dpslam] robot drivers: not available, the robot test will be skipped: $(tail -n 1 "$WS/drivers.log")" ;;
+  *) echo "[laser_dpslam] robot drivers: build failed (the robot test will fail); log: $WS/drivers.log" >&2 ;;
+esac
 cd "$WS"
 rm -rf "$WS/build/test_results"
 status=0
@@ -14,6 +23,7 @@ cp -r "$WS/build/test_results/." "$REPO/out/test_results/" 2>/dev/null || true
 summary=0
 catkin_test_results "$WS/build/test_results" --verbose > "$WS/test_summary.log" 2>&1 || summary=$?
 grep -v "^Skipping" "$WS/test_summary.log" | tail -n 40
+cat "$WS/build/test_results/laser_dpslam/robot_drivers_summary.txt" 2>/dev/null | sed 's/^/[laser_dpslam] robot test: /' || true
 if [[ $status -ne 0 ]]; then
   echo "[laser_dpslam] catkin_make run_tests failed (exit $status); log: $WS/test.log" >&2
   tail -n 40 "$WS/test.log" >&2
