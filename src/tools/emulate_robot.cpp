@@ -139,15 +139,21 @@ struct Body {
   Pose2D pose;
   double scale_left = 1.0, scale_right = 1.0, slip = 0.0;
   std::mt19937_64 rng;
-  std::normal_distribution<double> normal{0.0, 1.0};
+
+  // Box–Muller from 53-bit uniforms: the same seed gives the same robot on every platform (the
+  // standard library's normal_distribution differs between implementations).
+  double normal() {
+    const double u1 = ((rng() >> 11) + 1.0) * 0x1.0p-53, u2 = (rng() >> 11) * 0x1.0p-53;
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+  }
 
   void step(double left_mm_s, double right_mm_s, double dt, create_oi::SensorState& sensors) {
     const double dl = left_mm_s * dt / 1000.0, dr = right_mm_s * dt / 1000.0;
     // The encoders count the commanded travel; the ground sees it scaled and slipping.
     sensors.distance_mm += (dl + dr) / 2.0 * 1000.0;
     sensors.angle_deg += (dr - dl) / create_oi::kAxleLength * 180.0 / M_PI;
-    const double tl = dl * scale_left + slip * std::sqrt(std::abs(dl)) * normal(rng);  // σ ∝ √distance
-    const double tr = dr * scale_right + slip * std::sqrt(std::abs(dr)) * normal(rng);
+    const double tl = dl * scale_left + slip * std::sqrt(std::abs(dl)) * normal();  // σ ∝ √distance
+    const double tr = dr * scale_right + slip * std::sqrt(std::abs(dr)) * normal();
     const double ds = (tl + tr) / 2.0, dth = (tr - tl) / create_oi::kAxleLength;
     const double mid = pose.theta + dth / 2.0;
     pose = Pose2D(pose.x + ds * std::cos(mid), pose.y + ds * std::sin(mid), normalizeAngle(pose.theta + dth));
@@ -169,8 +175,8 @@ int run(const Options& o) {
   body.pose = Pose2D(o.x, o.y, o.theta);
   body.rng.seed(o.seed * 7919 + 13);
   if (!o.no_noise) {
-    body.scale_left = 1.0 + o.scale_noise * body.normal(body.rng);
-    body.scale_right = 1.0 + o.scale_noise * body.normal(body.rng);
+    body.scale_left = 1.0 + o.scale_noise * body.normal();
+    body.scale_right = 1.0 + o.scale_noise * body.normal();
     body.slip = o.slip_noise;
   }
   if (plan.occupied(o.x, o.y)) throw std::runtime_error("the start pose lies in a wall of " + o.floorplan);
@@ -201,7 +207,8 @@ int run(const Options& o) {
     if (!truth) throw std::runtime_error("cannot write " + o.truth);
     truth << std::fixed << std::setprecision(6);
   }
-  std::cerr << "emulate_robot: URG-04LX on " << o.laser_port << ", Create on " << o.create_port << "\n";
+  std::cerr << "emulate_robot: URG-04LX on " << o.laser_port << ", Create on " << o.create_port
+            << "; wheel scale errors left " << body.scale_left - 1.0 << ", right " << body.scale_right - 1.0 << "\n";
 
   double last = wallSeconds(), last_truth = 0.0;
   while (!g_stop) {
