@@ -17,16 +17,20 @@ DEB_PACKAGES=(libnodeletlib-dev libnodeletlib-tools libnodelet-dev libdiagnostic
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure libtf-dev libboost-all-dev
   libdiagnostic-msgs-dev patch)
 
-for a in "${ARCHIVES[@]}"; do
-  if [[ ! -f "$SRC/$a.tar.gz" ]]; then
-    echo "driver sources not found: $SRC/$a.tar.gz (set LASER_DPSLAM_DRIVERS to the folder of the" \
+for f in "${ARCHIVES[@]/%/.tar.gz}" debian12.patch; do
+  if [[ ! -f "$SRC/$f" ]]; then
+    echo "driver sources not found: $SRC/$f (set LASER_DPSLAM_DRIVERS to the folder of the" \
          "driver snapshots, see scripts/build_drivers.sh)" >&2
     exit 3
   fi
 done
 
-hash="$(cd "$SRC" && cat "${ARCHIVES[@]/%/.tar.gz}" debian12.patch 2>/dev/null | md5sum | cut -c1-10)"
+hash="$(cd "$SRC" && cat "${ARCHIVES[@]/%/.tar.gz}" debian12.patch | md5sum | cut -c1-10)"
 DWS="${LASER_DPSLAM_DRIVERS_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/laser_dpslam/drivers-$hash}"
+mkdir -p "$(dirname "$DWS")"
+# One build at a time (test runs of several checkouts share the cache); the others wait for it.
+exec 9>"$DWS.lock"
+flock 9
 if [[ -f "$DWS/.built" ]]; then
   echo "$DWS/devel_isolated"
   exit 0
@@ -49,9 +53,7 @@ echo "[build_drivers] building the drivers in $DWS (once; log: $DWS/build.log)" 
 rm -rf "$DWS"
 mkdir -p "$DWS/src"
 for a in "${ARCHIVES[@]}"; do tar -xzf "$SRC/$a.tar.gz" -C "$DWS/src"; done
-if [[ -f "$SRC/debian12.patch" ]]; then
-  (cd "$DWS/src" && patch -p1 --forward -s < "$SRC/debian12.patch") >&2
-fi
+(cd "$DWS/src" && patch -p1 --forward -s < "$SRC/debian12.patch") >&2
 export PATH="/usr/bin:$PATH"
 (
   cd "$DWS"
