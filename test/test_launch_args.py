@@ -15,6 +15,7 @@ FLAGS = {
     "slam.launch": ["slam"],
     "bag.launch": ["slam", "rviz", "publish_laser_tf", "exit_at_end"],
     "robot.launch": ["slam", "rviz", "create", "upside_down"],
+    "sim_robot.launch": ["slam", "rviz"],
 }
 
 
@@ -104,7 +105,23 @@ class LaunchArgsTest(unittest.TestCase):
     def test_robot_launch_keeps_wheel_odometry_out_of_the_way(self):
         n = nodes(load("robot.launch"))
         self.assertEqual(remaps(n["create_driver"]).get("odom"), "wheel_odom")
+        # create_autonomy's current package, node and parameter names (ca_driver was its old name).
+        self.assertEqual((n["create_driver"].package, n["create_driver"].type), ("create_driver", "create_driver"))
+        p = load("robot.launch", "create_port:=/dev/ttyUSB7").params
+        self.assertEqual(p["/create_driver/dev"].value, "/dev/ttyUSB7")
+        self.assertEqual(p["/create_driver/robot_model"].value, "CREATE_1")
+        self.assertEqual(p["/create_driver/odom_frame"].value, "odom")
+        self.assertEqual(p["/urg_node/serial_port"].value, "/dev/ttyACM0")
         self.assertEqual(len(n["laser_mount_tf"].args.split()), 8)  # x y z yaw pitch roll parent child
+
+    def test_sim_robot_launch_points_the_drivers_at_the_emulator(self):
+        c = load("sim_robot.launch", "rviz:=false")
+        n, p = nodes(c), c.params
+        args = n["emulate_robot"].args.split()
+        self.assertEqual(p["/urg_node/serial_port"].value, args[args.index("--laser-port") + 1])
+        self.assertEqual(p["/create_driver/dev"].value, args[args.index("--create-port") + 1])
+        self.assertTrue(os.path.isfile(args[args.index("--floorplan") + 1]))
+        self.assertNotIn("rviz", n)
 
     def test_urg_field_of_view_arguments(self):
         c = load("robot.launch", "angle_min:=-1.5", "angle_max:=1.5", "serial_port:=/dev/ttyUSB1")

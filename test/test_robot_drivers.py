@@ -1,19 +1,32 @@
 """robot.launch against the real drivers, urg_node and create_autonomy's create_driver, built from source by
-scripts/build_drivers.sh (scripts/test.sh puts that workspace on the package path): their executables exist
-under the names robot.launch starts, every parameter robot.launch gives them is one they read, and every topic
-robot.launch remaps is one they publish or subscribe. Without the drivers the test reports itself skipped
-with the reason."""
+scripts/build_drivers.sh: their executables exist under the names robot.launch starts, every parameter
+robot.launch gives them is one they read, and every topic robot.launch remaps is one they publish or
+subscribe. Without the driver sources the test reports itself skipped with the reason; after a failed build
+of them it fails."""
 import os
 import re
+import subprocess
 import unittest
 
 import roslaunch.config
-import roslib.packages
-import rospkg
 
 PKG = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-# What scripts/test.sh found when it tried to build the drivers (empty: built).
-SKIP_REASON = os.environ.get("LASER_DPSLAM_DRIVERS_SKIP", "")
+
+
+def drivers_devel():
+    """(devel_isolated of the drivers' workspace or None, why not): as scripts/test.sh found it, else by
+    running scripts/build_drivers.sh (a no-op once built)."""
+    if os.environ.get("LASER_DPSLAM_DRIVERS_DEVEL"):
+        return os.environ["LASER_DPSLAM_DRIVERS_DEVEL"], ""
+    if os.environ.get("LASER_DPSLAM_DRIVERS_FAILED"):
+        return None, "failed: the drivers did not build (%s)" % os.environ["LASER_DPSLAM_DRIVERS_FAILED"]
+    if os.environ.get("LASER_DPSLAM_DRIVERS_SKIP"):
+        return None, os.environ["LASER_DPSLAM_DRIVERS_SKIP"]
+    r = subprocess.run([os.path.join(PKG, "scripts", "build_drivers.sh")], capture_output=True, text=True)
+    if r.returncode == 0:
+        return r.stdout.strip().splitlines()[-1], ""
+    last = (r.stderr.strip().splitlines() or ["no message"])[-1]
+    return None, last if r.returncode == 3 else "failed: the drivers did not build (%s)" % last
 
 # The parameters a ROS 1 C++ node reads: nh.param<T>("name", ...), nh.param("name", ...), getParam("name", ...);
 # and the dynamic_reconfigure ones, read from the parameter server at start-up: gen.add("name", ...).
@@ -41,23 +54,28 @@ def matches(files, regex):
 class RobotDriversTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.rospack = rospkg.RosPack()
+        cls.devel, cls.why = drivers_devel()
         path = os.path.join(PKG, "launch", "robot.launch")
         cls.config = roslaunch.config.load_config_default([(path, ["rviz:=false"])], None, verbose=False)
         cls.nodes = {n.name: n for n in cls.config.nodes}
 
     def driver_dir(self, package):
-        try:
-            return self.rospack.get_path(package)
-        except rospkg.ResourceNotFound:
-            self.skipTest("driver package %s not found (%s)"
-                          % (package, SKIP_REASON or "scripts/build_drivers.sh not run: scripts/test.sh builds them"))
+        """The package's source folder in the drivers' workspace."""
+        if self.devel is None:
+            if self.why.startswith("failed"):
+                self.fail(self.why)
+            self.skipTest("robot drivers not available: " + self.why)
+        for root, dirs, files in os.walk(os.path.join(os.path.dirname(self.devel), "src")):
+            if os.path.basename(root) == package and "package.xml" in files:
+                return root
+        self.fail("no source of %s in %s" % (package, os.path.dirname(self.devel)))
 
     def check_node(self, name):
         node = self.nodes[name]
         root = self.driver_dir(node.package)
-        self.assertTrue(roslib.packages.find_node(node.package, node.type, rospack=self.rospack),
-                        "robot.launch starts %s/%s, which the driver does not build" % (node.package, node.type))
+        exe = os.path.join(self.devel, node.package, "lib", node.package, node.type)
+        self.assertTrue(os.access(exe, os.X_OK),
+                        "robot.launch starts %s/%s, which the driver does not build (%s)" % (node.package, node.type, exe))
         code = sources(root, r"\.(cpp|h|hpp)$")
         read = matches(code, PARAM_CALL) | matches(sources(root, r"\.cfg$"), CFG_ADD)
         given = {k.split("/")[-1] for k in self.config.params if k.startswith("/%s/" % name)}
