@@ -9,6 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "laser_dpslam/text_words.h"
+
 namespace laser_dpslam {
 
 void PathConfig::validate() const {
@@ -224,11 +226,7 @@ std::vector<std::vector<double>> loadNumberLines(const std::string& path, std::s
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    const std::size_t hash = line.find('#');
-    if (hash != std::string::npos) line.erase(hash);
-    std::istringstream tokens(line);
-    std::vector<std::string> words;
-    for (std::string w; tokens >> w;) words.push_back(w);
+    const std::vector<std::string> words = lineWords(line);
     if (words.empty()) continue;
     auto fail = [&](const std::string& why) {
       throw std::runtime_error(path + ":" + std::to_string(line_no) + ": " + why + " (expected " + expected + ")");

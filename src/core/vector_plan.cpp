@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "laser_dpslam/text_words.h"
+
 namespace laser_dpslam {
 
 namespace {
@@ -61,11 +63,7 @@ VectorPlan VectorPlan::parse(std::istream& in, const std::string& name) {
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    const std::size_t hash = line.find('#');
-    if (hash != std::string::npos) line.erase(hash);
-    std::istringstream tokens(line);
-    std::vector<std::string> words;
-    for (std::string w; tokens >> w;) words.push_back(w);
+    const std::vector<std::string> words = lineWords(line);
     if (words.empty()) continue;
     const std::function<void(std::string)> fail = [&](const std::string& why) {
       throw std::runtime_error(name + ":" + std::to_string(line_no) + ": " + why +
