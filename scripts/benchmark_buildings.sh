@@ -13,9 +13,11 @@
 # 90th percentile / worst of the drift and the SLAM ATE against the targets.
 # Two fixed seed lists: `bench` to tune on, `holdout` to evaluate only at the end (never tune on it).
 # Usage: scripts/benchmark_buildings.sh [--list bench|holdout] [--cases N] [--odometry-only]
-#          [--mode laser|wheels|both] [--config FILE.yaml] [--jobs 2] [--tag NAME]
-# Outputs: out/benchmark_buildings/buildings/seedN/ (plan, paths, bags; cached) and
-#          out/benchmark_buildings/runs/TAG-MODE/CASE/ (dpslam_offline's outputs, rerun every time).
+#          [--mode laser|wheels|both] [--config FILE.yaml] [--jobs 2] [--tag NAME] [--seeds "S ..."]
+# --seeds runs the given generated buildings instead of a list (to look into one case).
+# Outputs: out/benchmark_buildings/buildings/seedN/ (plan, paths, bags; cached: delete it after changing the
+#          generator or the simulator) and out/benchmark_buildings/runs/TAG-MODE[-odometry]/CASE/
+#          (dpslam_offline's outputs, rerun every time). Wheel rows add the drift of /wheel_odom alone.
 set -euo pipefail
 BENCH_SEEDS="1001 1002 1003 1004 1005 1006 1007 1008 1009 1010 1011 1012 1013 1014 1015
              1016 1017 1018 1019 1020 1021 1022 1023 1024 1025 1026 1027 1028 1029 1030"
@@ -28,6 +30,7 @@ MODE=both
 CONFIG=""
 JOBS=2
 TAG=default
+OVERRIDE=""
 while (($#)); do
   case "$1" in
     --list) LIST="$2"; shift 2 ;;
@@ -37,12 +40,14 @@ while (($#)); do
     --config) CONFIG="$(realpath "$2")"; shift 2 ;;
     --jobs) JOBS="$2"; shift 2 ;;
     --tag) TAG="$2"; shift 2 ;;
-    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
+    --seeds) OVERRIDE="$2"; shift 2 ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) echo "unknown argument: $1" >&2; exit 2 ;;
   esac
 done
 case "$LIST" in bench) SEEDS=$BENCH_SEEDS ;; holdout) SEEDS=$HOLDOUT_SEEDS ;;
   *) echo "--list must be bench or holdout" >&2; exit 2 ;; esac
+[[ -n $OVERRIDE ]] && SEEDS=$OVERRIDE LIST=custom
 case "$MODE" in laser|wheels|both) ;; *) echo "--mode must be laser, wheels or both" >&2; exit 2 ;; esac
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh" > /dev/null
 OUT="$REPO/out/benchmark_buildings"
@@ -51,6 +56,7 @@ mkdir -p "$OUT/buildings"
 CASE_LIST=()
 for s in $SEEDS; do CASE_LIST+=("seed$s"); done
 if ((CASES > 0)); then CASE_LIST=("${CASE_LIST[@]:0:CASES}"); elif [[ $LIST == bench ]]; then CASE_LIST+=(loop_building); fi
+for s in $SEEDS; do [[ $s =~ ^[0-9]+$ ]] || { echo "seed '$s' is not a number" >&2; exit 2; }; done
 MODES=()
 [[ $MODE != wheels ]] && MODES+=(laser)
 if [[ $MODE != laser ]]; then
@@ -81,7 +87,7 @@ run_case() {
     rosrun laser_dpslam simulate_scans --floorplan "$plan" "${path[@]}" "${extra[@]}" --seed 1 --out "$sim.tmp" \
       > /dev/null && mv "$sim.tmp" "$sim"
   fi
-  run="$OUT/runs/$TAG-$mode/$case"
+  run="$OUT/runs/$TAG-$mode$RUN_SUFFIX/$case"
   rm -rf "$run"; mkdir -p "$run"
   local args=(--bag "$sim/sim.bag" --out "$run/out" --quiet)
   [[ -n $CONFIG ]] && args+=(--config "$CONFIG")
@@ -90,6 +96,11 @@ run_case() {
   local row
   if rosrun laser_dpslam dpslam_offline "${args[@]}" > /dev/null 2> "$run/stderr.txt"; then
     row=$(/usr/bin/python3 "$REPO/scripts/benchmark_buildings_score.py" row "$run/out" "$sim/ground_truth.tum" "$SLAM")
+    if [[ $mode == wheels ]]; then
+      [[ -f $sim/wheel_drift.txt ]] || /usr/bin/python3 "$REPO/scripts/benchmark_buildings_score.py" wheels \
+        "$sim/sim.bag" "$sim/ground_truth.tum" > "$sim/wheel_drift.txt"
+      row="$row $(printf "%9s" "$(cat "$sim/wheel_drift.txt")")"
+    fi
   else
     row="FAIL - - - (see $run/stderr.txt)"
   fi
@@ -97,17 +108,21 @@ run_case() {
   echo "  done: $case $mode" >&2
 }
 export -f run_case
-export OUT REPO TAG CONFIG SLAM
+RUN_SUFFIX=""
+((SLAM)) || RUN_SUFFIX=-odometry
+export OUT REPO TAG CONFIG SLAM RUN_SUFFIX
 
 for mode in "${MODES[@]}"; do
   printf '%s\n' "${CASE_LIST[@]}" | xargs -P "$JOBS" -I{} bash -c 'run_case "$1" "$2"' _ {} "$mode" || true
 done
 # Rows in list order, then the summaries.
-printf "%-14s %-10s %-7s %7s %9s %8s %9s\n" case family mode metres "odo ATE" "drift %" "SLAM ATE"
+printf "%-14s %-10s %-7s %7s %9s %8s %9s %9s\n" case family mode metres "odo ATE" "drift %" "SLAM ATE" \
+  "(wheels %)"
 for mode in "${MODES[@]}"; do
   rows=()
-  for c in "${CASE_LIST[@]}"; do rows+=("$OUT/runs/$TAG-$mode/$c/row.txt"); done
+  for c in "${CASE_LIST[@]}"; do rows+=("$OUT/runs/$TAG-$mode$RUN_SUFFIX/$c/row.txt"); done
   cat "${rows[@]}" 2>/dev/null
   cat "${rows[@]}" 2>/dev/null | /usr/bin/python3 "$REPO/scripts/benchmark_buildings_score.py" summary "$mode" "$SLAM"
 done
-echo "(list $LIST, ${#CASE_LIST[@]} cases; outputs in $OUT/runs/$TAG-*; drift = final position error / distance)"
+echo "(list $LIST, ${#CASE_LIST[@]} cases; outputs in $OUT/runs/$TAG-*; drift = final position error / distance;"
+echo " (wheels %) = the drift of /wheel_odom alone)"

@@ -3,6 +3,8 @@
 
     benchmark_buildings_score.py row RUN_DIR GROUND_TRUTH.tum SLAM(0|1)
         prints "metres odometry-ATE drift-% SLAM-ATE" of one dpslam_offline run (evaluate_trajectory)
+    benchmark_buildings_score.py wheels BAG GROUND_TRUTH.tum
+        prints the drift % of the bag's /wheel_odom alone (the prior the wheel mode gets)
     benchmark_buildings_score.py summary MODE SLAM(0|1) < rows
         prints the median / 90th percentile / worst of the drift and the SLAM ATE over the rows, and whether
         they meet the targets of that mode, and the medians per building family (laser: drift median <= 1 %, p90 <= 2 %, SLAM ATE median <= 0.05 m,
@@ -30,6 +32,25 @@ def row(run, gt, slam):
     if slam == "1":
         s = "%9.3f" % evaluate(os.path.join(run, "trajectory.tum"), gt)["ate_rmse_m"]
     print("%7.1f %9.3f %8.2f %s" % (o["distance_m"], o["ate_rmse_m"], o["drift_percent"], s))
+
+
+def wheel_drift(bag_path, gt_path):
+    import numpy as np
+    import rosbag
+    odom = []
+    with rosbag.Bag(bag_path) as bag:
+        for _, m, _ in bag.read_messages(topics=["/wheel_odom"]):
+            odom.append((m.header.stamp.to_sec(), m.pose.pose.position.x, m.pose.pose.position.y))
+    if not odom:
+        sys.exit("%s: no /wheel_odom" % bag_path)
+    gt, odom = np.loadtxt(gt_path, ndmin=2), np.array(odom)
+    # The odom frame is the first true pose: put the final odometry position into the map frame.
+    th = 2 * math.atan2(gt[0, 6], gt[0, 7])
+    x = math.cos(th) * odom[-1, 1] - math.sin(th) * odom[-1, 2] + gt[0, 1]
+    y = math.sin(th) * odom[-1, 1] + math.cos(th) * odom[-1, 2] + gt[0, 2]
+    gx, gy = np.interp(odom[-1, 0], gt[:, 0], gt[:, 1]), np.interp(odom[-1, 0], gt[:, 0], gt[:, 2])
+    distance = np.sum(np.hypot(np.diff(gt[:, 1]), np.diff(gt[:, 2])))
+    print("%.2f" % (100.0 * math.hypot(x - gx, y - gy) / distance))
 
 
 def percentile(v, q):
@@ -74,6 +95,8 @@ def summary(mode, slam):
 if __name__ == "__main__":
     if len(sys.argv) == 5 and sys.argv[1] == "row":
         row(*sys.argv[2:])
+    elif len(sys.argv) == 4 and sys.argv[1] == "wheels":
+        wheel_drift(*sys.argv[2:])
     elif len(sys.argv) == 4 and sys.argv[1] == "summary":
         summary(sys.argv[2], sys.argv[3])
     else:

@@ -102,11 +102,13 @@ class Layout:
     def __init__(self, rng, family, rng_range):
         self.rng, self.family, self.range = rng, family, rng_range
         if family == "blank":
-            self.W = rng.uniform(2.0, 8.0) * rng_range + 2.0
+            self.W = rng.uniform(2.0, 8.0) * rng_range  # plus the side corridors, below
             self.H = rng.uniform(6.0, 10.0)
         else:
             self.W, self.H = rng.uniform(14.0, 22.0), rng.uniform(8.0, 13.0)
         self.width = {k: rng.uniform(1.2, 4.0) for k in ("bottom", "top", "left", "right")}
+        if family == "blank":  # the stretch between the openings of the side corridors is 2-8 x the range
+            self.W += (self.width["left"] + self.width["right"]) / 2
         self.cross = []
         if family == "grid" or (family == "ring" and rng.random() < 0.2):
             n = 1 if self.W < 18 or rng.random() < 0.5 else 2
@@ -387,6 +389,7 @@ def generate(seed, family, out_dir, rng_range):
             "route_m": sum(math.dist(a, e) for a, e in zip(route, route[1:])),
             "ring_m": [round(lay.W, 2), round(lay.H, 2)],
             "corridor_widths_m": {k: round(v, 2) for k, v in lay.width.items()},
+            "blank_side_m": round(lay.W - (lay.width["left"] + lay.width["right"]) / 2, 2) if family == "blank" else None,
             "cross_corridors": len(lay.cross), "dead_end_m": round(lay.spur[1], 2) if lay.spur else None,
             "hall_m": [round(lay.hall[1] - lay.hall[0], 2), round(lay.hall[2], 2)] if lay.hall else None,
             "walls": len(segs), "pillars": len(b.circles), "furniture": len(b.polygons),

@@ -44,6 +44,7 @@ class GenerateBuildingTest(unittest.TestCase):
             out = tempfile.mkdtemp()
             meta = generate(seed, out, "blank")
             self.assertGreater(meta["longest_blank_m"], 0.5, meta)
+            self.assertTrue(2 * 5.6 <= meta["blank_side_m"] <= 8 * 5.6, meta)
             self.assertGreaterEqual(meta["wheel_stops_in_corridors"], 1, meta)
             self.assertGreaterEqual(meta["route_m"], 80.0)
             laser, wheels = waypoints(os.path.join(out, "path_laser.txt")), waypoints(os.path.join(out, "path_wheels.txt"))
