@@ -66,10 +66,10 @@ TEST(CreateOi, LibcreateSessionDrivesAndStreams) {
   EXPECT_EQ(d.rightVelocity(), 0.0);
   Bytes stream = {148, static_cast<std::uint8_t>(kLibcreateIds.size())};
   stream.insert(stream.end(), kLibcreateIds.begin(), kLibcreateIds.end());
-  Bytes session;
-  session.push_back(128);
-  for (std::uint8_t b : stream) session.push_back(b);
-  d.feed(session, s);
+  Bytes exchange;
+  exchange.push_back(128);
+  for (std::uint8_t b : stream) exchange.push_back(b);
+  d.feed(exchange, s);
   EXPECT_EQ(d.mode(), kPassive);
   EXPECT_TRUE(d.streaming());
   d.feed({145, 0, 200, 0, 100}, s);  // passive: actuators ignored
