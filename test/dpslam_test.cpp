@@ -39,7 +39,7 @@ const SimRun& loopRun() {
     // so that they test the filter on a fixed input. With
     // 10 keyframes and the retry this loop's SLAM max error over filter seeds 1-5 was
     // 0.127/0.111/0.084/0.072/0.092 m against 0.104/0.099/0.085/0.090/0.074 m (same end errors, 0.018 m
-    // mean); the pipeline is measured by the benchmarks (README "Benchmarks").
+    // mean); the pipeline is measured by the benchmarks (doc/benchmarks.md).
     LaserOdometryConfig odometry_config;
     odometry_config.local_map_keyframes = 5;
     odometry_config.matcher.rescue_margin = 0.0;

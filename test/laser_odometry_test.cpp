@@ -197,9 +197,9 @@ TEST(LaserOdometry, MountedLaserGivesTheBasePose) {
 // Measured with seeds 1-4 (final error, m): gain 1: 1.29, 0.97, 1.22, 0.79; gain 0.3: 0.45, 0.21, 0.42, 0.44.
 // Not fixed by it: starting from rest 2 m further south (the north wall 3.3 m away) stalls for seconds with
 // any gain. The drive starts exactly parallel to the walls, which lie on the plan's 5 cm lattice: the case
-// where align_to_walls (on by default since the twenty-eighth session) costs, its frame being ~0.3° off the
+// where align_to_walls (on by default since 2026-12-03) costs, its frame being ~0.3° off the
 // walls (this corridor from rest, 10 starts shifted 0-5 cm: 0.154 m mean final error with it off, 0.273 m
-// on; the loop started a few degrees off the walls, as a real run is, gains from it: README "Tune"). The
+// on; the loop started a few degrees off the walls, as a real run is, gains from it: doc/tuning.md). The
 // smoothing is measured in the frame along the walls.
 TEST(LaserOdometry, SmoothedVelocityShrinksTheCorridorLag) {
   auto finalError = [](double gain, std::uint64_t seed) {
@@ -257,7 +257,7 @@ TEST(LaserOdometry, RangeMarginLeavesTheFarthestPointsOutOfTheMatch) {
 // degenerate_velocity_gain (0.1 for lasers up to 10 m) averages it over more scans. Final error, seeds 1-3
 // (m), both with match_range_margin 0.5: 0.228, 0.263, 0.180; with degenerate_velocity_gain 0.1 as well: 0.161, 0.061, 0.160
 // (with neither: 0.262, 0.240, 0.218). On the whole loop it helps too (scripts/benchmark_loop.sh), but it
-// costs CSAIL (README).
+// costs CSAIL (doc/tuning.md).
 TEST(LaserOdometry, DegenerateVelocityGainShrinksTheCorridorStall) {
   LaserOdometryConfig margin, with_gain;
   margin.match_range_margin = 0.5;

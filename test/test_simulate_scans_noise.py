@@ -1,6 +1,6 @@
 """simulate_scans --range-noise / --range-noise-fraction: the range noise of the simulated URG-04LX can be
 set (sigma = max(M, F * range)), so that a user can match their sensor and so that the effect of range noise
-on the SLAM can be measured (README "Benchmarks"). Compared beam by beam with a --no-noise run of the same
+on the SLAM can be measured (doc/benchmarks.md). Compared beam by beam with a --no-noise run of the same
 path and seed."""
 import math
 import os

@@ -30,7 +30,7 @@ class WorkerPool;
 struct DpSlamConfig {
   // --- Particle filter ---
   int particles = 30;               ///< P
-  int oversampling = 4;             ///< candidate poses drawn per particle; the best by the cheap score is kept (1 = off; README "Benchmarks": 4 closes every loop-building seed)
+  int oversampling = 4;             ///< candidate poses drawn per particle; the best by the cheap score is kept (1 = off; doc/benchmarks.md: 4 closes every loop-building seed)
   double cull_window = 0.25;        ///< m, half-width around each measured range traced by the cheap score
   double resample_threshold = 0.5;  ///< resample when Neff < this × P (1 = every update)
   int refine_iterations = 0;        ///< improved proposal: hill-climbing steps of each particle on its own map (0 = off)
@@ -47,7 +47,7 @@ struct DpSlamConfig {
   /// On old ground (see explore_noise_scale) the map keeps what it has: scans write only cells the particle
   /// has no entry for (new space). Updated, a particle arriving 0.1-0.3 m off the old map writes its offset
   /// view over it (5.6 m ahead of itself), those fresh walls outweigh the old ones, and the filter turns
-  /// along the ridge between them instead of stepping across (doc/experiments.md, twenty-third session).
+  /// along the ridge between them instead of stepping across (doc/experiments.md, 2026-12-02).
   bool revisit_freeze_map = true;
   double revisit_min_travel = 10.0;  ///< m of travel after which a stretch of path counts as old (revisitable)
   double min_travel_distance = 0.0;  ///< m; the filter updates once the robot moved this far ... (0 = off)

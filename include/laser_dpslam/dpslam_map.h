@@ -134,21 +134,21 @@ class DpSlamMap : public AncestryHooks {
   /// both likelihoods alike. A cell holds stops per metre of *normal* depth, whatever the angle the beams
   /// came from: without it, the stops that range noise spreads in front of a surface (written mostly by
   /// head-on beams, one cell of chord each) stop oblique beams early, which travel 1/cos as far through
-  /// them, and the filter prefers poses behind the truth (maps too short, README "Benchmarks"). 0 = off.
+  /// them, and the filter prefers poses behind the truth (maps too short, doc/benchmarks.md). 0 = off.
   void setSurfaceDepth(double depth) { surface_depth_ = depth; }
   double surfaceDepth() const { return surface_depth_; }
   /// Cell normals. A cell in which a beam with a known surface normal (MapBeam::nx, ny) stopped remembers
   /// that normal (the last one, to 0.7°) in the writing lineage's entry (MapEntry::normal), so each particle
   /// sees the normals of its own history, as it sees its own stops: one normal per cell shared by all
   /// particles (last writer wins) let a lineage's normals shape the others' scores, and the MIT CSAIL log
-  /// closed its big loop cleanly with 14 of filter seeds 1–20 instead of 17 (README "Benchmarks"). Then
+  /// closed its big loop cleanly with 14 of filter seeds 1–20 instead of 17 (doc/benchmarks.md). Then
   /// distance through the cell counts along its normal — times |cos| between the beam and the normal,
   /// bounded below by `min_cos` — for every beam that crosses it, in the writes and
   /// in both likelihoods alike, whether the beam ends there or passes by: the cell holds stops per metre of
   /// normal depth. This is setSurfaceDepth for the beams that pass a surface instead of ending on it: the
   /// range noise of a wall's writers leaves stops in the free cells in front of it, and a beam grazing along
   /// the wall through them (towards a corner beyond it) was stopped there early, so that poses moved away
-  /// from the wall scored better (the end faces of niches pulled the filter behind, README "Benchmarks").
+  /// from the wall scored better (the end faces of niches pulled the filter behind, doc/benchmarks.md).
   /// Cells without a normal keep the setSurfaceDepth rule. 0 = off.
   void setCellNormals(double min_cos) { cell_normal_min_cos_ = min_cos; }
   double cellNormals() const { return cell_normal_min_cos_; }
@@ -159,7 +159,7 @@ class DpSlamMap : public AncestryHooks {
   /// a wall's range is known to a fraction of a cell wherever it lies against the grid, as an NDT cell's
   /// mean is. Without it, walls that happen to lie on cell boundaries (parallel to the rows) are all seen at
   /// the same depth, walls between them anywhere within half a cell, and the filter is pulled by the
-  /// difference (README "Benchmarks", start jitter). false = off.
+  /// difference (doc/benchmarks.md, start jitter). false = off.
   void setSurfaceOffsets(bool on) { surface_offsets_ = on; }
   bool surfaceOffsets() const { return surface_offsets_; }
   /// MapEntry::offset: 0 = none, else k in 1..255 for (k − 128)/127 · 0.75 · resolution m.

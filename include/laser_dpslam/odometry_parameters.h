@@ -1,5 +1,5 @@
 // The laser odometry's parameters: one table, read from any ParameterSource (YAML file or ROS).
-// Names and units are documented in config/laser_odometry.yaml and the README.
+// Names and units are documented in config/laser_odometry.yaml and doc/parameters.md.
 #pragma once
 
 #include "laser_dpslam/laser_odometry.h"

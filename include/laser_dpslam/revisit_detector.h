@@ -2,7 +2,7 @@
 // of it at least `min_travel` metres of travel earlier (the robot came back to mapped ground, where a
 // particle filter can correct its pose against an older part of its map). DP-SLAM uses it to scale the
 // proposal noise: while exploring, the particles' spread cannot be told apart by their own fresh maps and
-// only random-walks (README "Benchmarks"). No ROS.
+// only random-walks (doc/benchmarks.md). No ROS.
 #pragma once
 
 #include <Eigen/Core>

@@ -46,7 +46,7 @@ struct ScanMatcherConfig {
   double degenerate_sigma = 0.3;        ///< m, σ added along a degenerate translation direction
   /// m, the same when the soft motion prior took part in the match (prior_sigma_xy > 0): the prior then
   /// holds that direction to about its own σ per scan, and a σ of 0.3 m per scan let the DP-SLAM's
-  /// particles random-walk along corridors (README "Benchmarks").
+  /// particles random-walk along corridors (doc/benchmarks.md).
   double degenerate_sigma_with_prior = 0.02;
   bool keep_prior_when_degenerate = false;  ///< along a degenerate direction keep the motion prior exactly (superseded by the soft prior of LaserOdometryConfig::prior_acceleration)
   /// m; > 0: the Newton polish minimises h + α/2·|t − t_prior|²/σ² (a Gaussian motion prior of this σ on the
@@ -58,7 +58,7 @@ struct ScanMatcherConfig {
   double weak_inflation = 10.0;         ///< covariance multiplier for a weak match
   /// > 0: a weak match is retried from the prior itself and by DE over ±rescue_window_theta; a retry
   /// replaces it only when its score per point is higher by more than this. 0 = no retry. It removes the
-  /// odometry's turn failures (MIT CSAIL at 4.7 Hz, an in-place turn of the loop building); see the README.
+  /// odometry's turn failures (MIT CSAIL at 4.7 Hz, an in-place turn of the loop building); see doc/benchmarks.md.
   double rescue_margin = 0.05;
   double rescue_window_theta = 0.79;    ///< rad, θ half-width of the retry's DE window (≈ 45°)
   /// Prior release (only where the caller allows it, see LaserOdometryConfig::prior_release_speed): a

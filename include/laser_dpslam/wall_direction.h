@@ -1,7 +1,7 @@
 // The dominant wall direction of a scan, modulo 90° (indoor walls mostly meet at right angles). The laser
 // odometry turns its local map's grid to it: NDT's cells are axis-aligned, and the same scans matched in a
 // frame whose axes run along the walls drift half as much on the simulated loop building as in one turned
-// by a few degrees (README "Benchmarks", doc/experiments.md). No ROS.
+// by a few degrees (doc/benchmarks.md, doc/experiments.md). No ROS.
 #pragma once
 
 #include <Eigen/Core>

@@ -319,7 +319,7 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
   // 1. Proposal: each particle moves by the delta plus noise, in its own frame. Draws in a fixed order.
   Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal);
   // Exploring, the noise mostly random-walks the particles (their fresh maps move with them); back on old
-  // ground it is what lets the filter find the older map's alignment (README "Benchmarks").
+  // ground it is what lets the filter find the older map's alignment (doc/benchmarks.md).
   const Pose2D ahead = poses_[best_] * delta;
   last_revisit_ = revisit_.update(Eigen::Vector2d(ahead.x, ahead.y), std::hypot(delta.x, delta.y));
   if (!last_revisit_) L *= config_.explore_noise_scale;

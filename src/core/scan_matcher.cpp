@@ -128,7 +128,7 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool
   };
   // Where the polish ended on a ridge (H indefinite: h curves down, typically in heading) a negative
   // eigenvalue is floored to nothing, which says "unknown" along it; the SLAM's proposal spreads its
-  // particles along that direction and is better for it (README "Reliability"). The pose covariance takes
+  // particles along that direction and is better for it (doc/reliability.md). The pose covariance takes
   // the curvature's magnitude instead (how fast h changes there: saddle-free, Dauphin et al. 2014), within
   // the search window.
   r.bounded_covariance = boundedByWindow(fromEigenvalues(es.eigenvalues().cwiseAbs()));
