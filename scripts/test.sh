@@ -4,19 +4,15 @@
 # summary, copy the JUnit XML to out/test_results/, exit non-zero on any failure.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
-# The robot drivers (urg_node, create_driver) for test/robot_drivers.test and test/test_robot_drivers.py:
-# built once from the source snapshots, cached outside the repository; without the sources those tests
-# report themselves skipped with the reason, after a failed build they fail.
+# The robot drivers (urg_node, create_driver) for the robot tests: built once here from the source snapshots
+# and cached outside the repository (the tests call the same script, a no-op by then); without the sources
+# those tests report themselves skipped, after a failed build they fail.
 drivers_status=0
 "$REPO/scripts/build_drivers.sh" > "$WS/drivers.log" 2>&1 || drivers_status=$?
-export LASER_DPSLAM_DRIVERS_DEVEL="" LASER_DPSLAM_DRIVERS_SKIP="" LASER_DPSLAM_DRIVERS_FAILED=""
 case $drivers_status in
-  0) LASER_DPSLAM_DRIVERS_DEVEL="$(tail -n 1 "$WS/drivers.log")"
-     echo "[laser_dpslam] robot drivers: $LASER_DPSLAM_DRIVERS_DEVEL" ;;
-  3) LASER_DPSLAM_DRIVERS_SKIP="$(tail -n 1 "$WS/drivers.log")"
-     echo "[laser_dpslam] robot drivers: not available, the robot tests will be skipped: $LASER_DPSLAM_DRIVERS_SKIP" ;;
-  *) LASER_DPSLAM_DRIVERS_FAILED="log: $WS/drivers.log"
-     echo "[laser_dpslam] robot drivers: build failed (the robot tests will fail); log: $WS/drivers.log" >&2 ;;
+  0) echo "[laser_dpslam] robot drivers: $(tail -n 1 "$WS/drivers.log")" ;;
+  3) echo "[laser_dpslam] robot drivers: not available, the robot tests will be skipped: $(tail -n 1 "$WS/drivers.log")" ;;
+  *) echo "[laser_dpslam] robot drivers: build failed (the robot tests will fail); log: $WS/drivers.log" >&2 ;;
 esac
 cd "$WS"
 rm -rf "$WS/build/test_results"

@@ -19,6 +19,8 @@ import threading
 import time
 import unittest
 
+from drivers_workspace import DriversUnavailable, drivers_devel
+
 PKG = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 # Waypoints in the office plan (m): out of the west corridor's room N1 and east along the corridor.
 WAYPOINTS = [(3.5, 6.0), (3.5, 8.6), (3.5, 6.0), (8.0, 6.0), (12.0, 6.0)]
@@ -46,17 +48,6 @@ def report_skipped(reason):
                     '  <testcase classname="robot_drivers_rostest.RobotDrivers" name="test_robot_drivers">\n'
                     '    <skipped message=%s/>\n  </testcase>\n</testsuite>\n' % quoteattr(reason))
     sys.exit(0)
-
-
-def drivers_devel():
-    """The drivers' devel_isolated (built once, cached), or skip with the build script's reason."""
-    p = subprocess.run([os.path.join(PKG, "scripts", "build_drivers.sh")], stdout=subprocess.PIPE,
-                       stderr=subprocess.PIPE, universal_newlines=True)
-    if p.returncode == 3:
-        report_skipped(p.stderr.strip().splitlines()[-1] if p.stderr.strip() else "no driver sources")
-    if p.returncode != 0:
-        raise RuntimeError("scripts/build_drivers.sh failed:\n" + p.stderr[-3000:])
-    return p.stdout.strip().splitlines()[-1]
 
 
 def overlay_env(drivers):
@@ -324,7 +315,10 @@ NUMBERS = {}
 DRIVERS = None
 
 if __name__ == "__main__":
-    DRIVERS = drivers_devel()
+    try:
+        DRIVERS = drivers_devel()
+    except DriversUnavailable as e:
+        report_skipped(str(e))
     import rostest
     try:
         rostest.rosrun("laser_dpslam", "robot_drivers", RobotDrivers)

@@ -1,33 +1,17 @@
 """robot.launch against the real drivers, urg_node and create_autonomy's create_driver, built from source by
 scripts/build_drivers.sh: their executables exist under the names robot.launch starts, every parameter
 robot.launch gives them is one they read, and every topic robot.launch remaps is one they publish or
-subscribe. Without the driver sources the test reports itself skipped with the reason; after a failed build
-of them it fails."""
+subscribe. Without the driver sources the test reports itself skipped with the reason; when they fail to build
+it fails."""
 import os
 import re
-import subprocess
 import unittest
 
 import roslaunch.config
 
+from drivers_workspace import DriversUnavailable, drivers_devel
+
 PKG = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-
-
-def drivers_devel():
-    """(devel_isolated of the drivers' workspace or None, why not): as scripts/test.sh found it, else by
-    running scripts/build_drivers.sh (a no-op once built)."""
-    if os.environ.get("LASER_DPSLAM_DRIVERS_DEVEL"):
-        return os.environ["LASER_DPSLAM_DRIVERS_DEVEL"], ""
-    if os.environ.get("LASER_DPSLAM_DRIVERS_FAILED"):
-        return None, "failed: the drivers did not build (%s)" % os.environ["LASER_DPSLAM_DRIVERS_FAILED"]
-    if os.environ.get("LASER_DPSLAM_DRIVERS_SKIP"):
-        return None, os.environ["LASER_DPSLAM_DRIVERS_SKIP"]
-    r = subprocess.run([os.path.join(PKG, "scripts", "build_drivers.sh")], capture_output=True, text=True)
-    if r.returncode == 0:
-        return r.stdout.strip().splitlines()[-1], ""
-    last = (r.stderr.strip().splitlines() or ["no message"])[-1]
-    return None, last if r.returncode == 3 else "failed: the drivers did not build (%s)" % last
-
 # The parameters a ROS 1 C++ node reads: nh.param<T>("name", ...), nh.param("name", ...), getParam("name", ...);
 # and the dynamic_reconfigure ones, read from the parameter server at start-up: gen.add("name", ...).
 PARAM_CALL = re.compile(r'(?:\bparam\s*(?:<[^>]*>)?|getParam)\s*\(\s*"([^"]+)"')
@@ -54,17 +38,23 @@ def matches(files, regex):
 class RobotDriversTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.devel, cls.why = drivers_devel()
+        cls.devel, cls.skip, cls.error = None, "", ""
+        try:
+            cls.devel = drivers_devel()
+        except DriversUnavailable as e:
+            cls.skip = str(e)
+        except RuntimeError as e:
+            cls.error = str(e)
         path = os.path.join(PKG, "launch", "robot.launch")
         cls.config = roslaunch.config.load_config_default([(path, ["rviz:=false"])], None, verbose=False)
         cls.nodes = {n.name: n for n in cls.config.nodes}
 
     def driver_dir(self, package):
         """The package's source folder in the drivers' workspace."""
+        if self.error:
+            self.fail(self.error)
         if self.devel is None:
-            if self.why.startswith("failed"):
-                self.fail(self.why)
-            self.skipTest("robot drivers not available: " + self.why)
+            self.skipTest("robot drivers not available: " + self.skip)
         for root, dirs, files in os.walk(os.path.join(os.path.dirname(self.devel), "src")):
             if os.path.basename(root) == package and "package.xml" in files:
                 return root
