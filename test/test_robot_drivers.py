@@ -5,11 +5,14 @@ subscribe. Without the driver sources the test reports itself skipped with the r
 it fails."""
 import os
 import re
+import sys
 import unittest
 
 import roslaunch.config
 
-from drivers_workspace import DriversUnavailable, drivers_devel
+# catkin runs nosetests with -P (no path adjustment): the helper beside this file is found through its folder.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from drivers_workspace import DriversUnavailable, drivers_devel  # noqa: E402
 
 PKG = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 # The parameters a ROS 1 C++ node reads: nh.param<T>("name", ...), nh.param("name", ...), getParam("name", ...);
