@@ -74,6 +74,26 @@ TEST(BagScanReader, AcceptsExactlyOneWellFormedTfMessage) {
   EXPECT_NE(why.find("frame_id length"), std::string::npos) << why;
 }
 
+TEST(BagScanReader, AcceptsExactlyOneWellFormedOdometry) {
+  nav_msgs::Odometry o;
+  o.header.frame_id = "odom";
+  o.child_frame_id = "base_footprint";
+  o.pose.pose.orientation.w = 1.0;
+  std::vector<std::uint8_t> b(ros::serialization::serializationLength(o));
+  ros::serialization::OStream out(b.data(), static_cast<std::uint32_t>(b.size()));
+  ros::serialization::serialize(out, o);
+  std::string why;
+  ASSERT_TRUE(serializedOdometryFits(b.data(), b.size(), &why)) << why;
+  for (std::size_t n = 0; n < b.size(); ++n) EXPECT_FALSE(serializedOdometryFits(b.data(), n, &why)) << n;
+  b.push_back(0);
+  EXPECT_FALSE(serializedOdometryFits(b.data(), b.size(), &why));
+  EXPECT_NE(why.find("left over"), std::string::npos) << why;
+  b.pop_back();
+  putLength(&b[20], 0xFFFFFFF0u);  // child_frame_id's length, after seq, stamp and "odom"
+  EXPECT_FALSE(serializedOdometryFits(b.data(), b.size(), &why));
+  EXPECT_NE(why.find("child_frame_id length"), std::string::npos) << why;
+}
+
 TEST(BagScanReader, AcceptsExactlyOneWellFormedScan) {
   std::vector<std::uint8_t> b = serialize(urgScan(1.0));
   std::string why;

@@ -12,9 +12,9 @@ import yaml
 
 PKG = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 FLAGS = {
-    "slam.launch": ["slam"],
+    "slam.launch": ["slam", "wheel_odometry"],
     "bag.launch": ["slam", "rviz", "publish_laser_tf", "exit_at_end"],
-    "robot.launch": ["slam", "rviz", "create", "upside_down"],
+    "robot.launch": ["slam", "rviz", "create", "upside_down", "wheel_odometry"],
     "sim_robot.launch": ["slam", "rviz"],
 }
 
@@ -113,6 +113,16 @@ class LaunchArgsTest(unittest.TestCase):
         self.assertEqual(p["/create_driver/odom_frame"].value, "odom")
         self.assertEqual(p["/urg_node/serial_port"].value, "/dev/ttyACM0")
         self.assertEqual(len(n["laser_mount_tf"].args.split()), 8)  # x y z yaw pitch roll parent child
+
+    def test_wheel_odometry_reaches_the_laser_odometry(self):
+        def use(*args):
+            return load("robot.launch", *args).params["/laser_odometry_node/use_wheel_odometry"].value
+        self.assertFalse(use())  # the YAML's default: laser only
+        self.assertTrue(use("wheel_odometry:=true"))
+        self.assertFalse(use("wheel_odometry:=true", "create:=false"))  # no base driver, no wheels
+        self.assertEqual(remaps(nodes(load("robot.launch"))["laser_odometry_node"]).get("wheel_odom"), "wheel_odom")
+        n = nodes(load("slam.launch", "wheel_odometry:=true", "wheel_odom_topic:=odom_wheels"))
+        self.assertEqual(remaps(n["laser_odometry_node"]).get("wheel_odom"), "odom_wheels")
 
     def test_sim_robot_launch_points_the_drivers_at_the_emulator(self):
         c = load("sim_robot.launch", "rviz:=false")

@@ -34,11 +34,11 @@ class OfflineMalformedInputTest(unittest.TestCase):
         data[at:at + 4] = value.to_bytes(4, "little")
         return self.write_bag(bytes(data))
 
-    def run_offline(self, bag):
+    def run_offline(self, bag, extra=()):
         out = os.path.join(self.dir, "out")
         # A timeout: a corrupted array length used to make the deserializer allocate gigabytes for minutes.
-        p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", bag, "--out", out, "--quiet"],
-                           capture_output=True, text=True, timeout=120)
+        p = subprocess.run(["rosrun", "laser_dpslam", "dpslam_offline", "--bag", bag, "--out", out, "--quiet"]
+                           + list(extra), capture_output=True, text=True, timeout=120)
         self.assertNotEqual(p.returncode, 0, p.stderr)
         self.assertNotIn("terminate called", p.stderr)  # a handled error, not an abort
         self.assertIn("dpslam_offline: ", p.stderr)
@@ -93,6 +93,12 @@ class OfflineMalformedInputTest(unittest.TestCase):
         self.assertTrue(os.path.exists(os.path.join(out, "odometry.tum")))
         # Peak memory of every child so far (kB): deserializing that record used to take 2.7 GB.
         self.assertLess(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, 1 << 20)
+
+    def test_wheel_odometry_topic_missing(self):
+        # The demo bag has no wheel odometry: the error names the topic and the Odometry topics it has.
+        err = self.run_offline(self.write_bag(self.demo), ["--wheel-odom", "/wheel_odom"])
+        self.assertIn("--wheel-odom: no messages on /wheel_odom", err)
+        self.assertIn("Odometry topics in the bag: /ground_truth", err)
 
     def test_the_intact_bag_still_runs(self):
         # The same helpers on the untouched bag: the failures above come from the damage, not the set-up.

@@ -103,6 +103,7 @@ struct OdometryUpdate {
   MatchResult match;                  ///< its pose and weak_direction are in the matching frame (frameAngle())
   RangeFlow range_flow;               ///< the speed along match.weak_direction from the range flow (range_flow_gain)
   bool range_flow_applied = false;    ///< it (with the previous scan's) refuted the velocity and moved it
+  bool wheel_prior = false;           ///< the motion prior was the wheel odometry's (addWheelOdometry)
   bool new_keyframe = false;
   int points_used = 0;
 };
@@ -114,8 +115,15 @@ class LaserOdometry {
   /// Processes one preprocessed scan (laser frame) with the laser's mount on the robot.
   OdometryUpdate process(const PreprocessedScan& scan, const LaserMount& mount);
 
-  /// Forgets everything (next scan starts at the identity).
+  /// Forgets everything (next scan starts at the identity). Wheel odometry samples are kept: they are a time
+  /// line of their own (addWheelOdometry).
   void reset();
+
+  /// A wheel odometry pose (in the wheels' own fixed frame) at `stamp`. From then on the wheels' motion
+  /// between two scan stamps replaces the constant-velocity prediction, and along a direction the scan does
+  /// not constrain (a corridor) the match keeps it: the laser decides wherever it sees structure, the wheels
+  /// carry the robot where it does not. A stamp not after the last sample's starts a new time line.
+  void addWheelOdometry(double stamp, const Pose2D& pose);
 
   /// odom → base_link (the odom frame is the first pose).
   Pose2D pose() const { return toOdom(pose_); }
@@ -130,7 +138,18 @@ class LaserOdometry {
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of `pose`, odom frame
     std::vector<Eigen::Vector2d> points;  ///< in the matching frame (the odom frame unless align_to_walls)
   };
+  struct WheelSample {
+    double stamp;
+    Pose2D pose;
+  };
   void addKeyframe(const std::vector<Eigen::Vector2d>& base_points);
+  /// The wheels' motion from stamp `from` to `to` (in the robot's frame at `from`), interpolated between
+  /// samples; false when the samples do not cover that interval.
+  bool wheelMotion(double from, double to, Pose2D* motion) const;
+  /// The wheel pose at `t` (interpolated, or extrapolated a little past the last sample); false outside.
+  bool wheelPoseAt(double t, Pose2D* pose) const;
+  /// The motion prior from the last scan to `stamp`: the wheels' when they cover it, else constant velocity.
+  Pose2D priorDelta(double stamp, bool* from_wheels) const;
   /// process() in the matching frame: u.pose, u.pose_covariance and pose_ are in it.
   OdometryUpdate processInFrame(const PreprocessedScan& scan, const LaserMount& mount);
   /// A pose of the matching frame in the odom frame.
@@ -153,6 +172,7 @@ class LaserOdometry {
   Eigen::Vector2d last_flow_direction_ = Eigen::Vector2d::Zero();  ///< its direction (the match's weak direction, matching frame)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;
+  std::deque<WheelSample> wheels_;  ///< wheel odometry since shortly before the last scan (addWheelOdometry)
 };
 
 }  // namespace laser_dpslam

@@ -108,9 +108,11 @@ class ScanMatcher {
   /// of the estimate grows with them, and Newton needs only a few evaluations).
   /// `prior_sigma_xy` < 0: the config's; otherwise this scan's σ of the motion prior (see the config).
   /// `allow_prior_release`: a degenerate match may drop that prior (ScanMatcherConfig::prior_release_margin).
+  /// `hold_prior_when_degenerate`: along a degenerate direction keep the prior exactly, as
+  /// keep_prior_when_degenerate does, for this match (the prior is a measurement: wheel odometry).
   MatchResult match(const std::vector<Eigen::Vector2d>& search_points, const std::vector<Eigen::Vector2d>& polish_points,
                     const Pose2D& prior, std::mt19937_64& rng, double prior_sigma_xy = -1.0,
-                    bool allow_prior_release = false) const;
+                    bool allow_prior_release = false, bool hold_prior_when_degenerate = false) const;
 
   /// Newton polish only, from `start`, on resolution level `level` (exposed for tests). With `basis`
   /// (3×k, orthonormal columns) the steps stay in the subspace it spans. `final_score`: the level's NDT

@@ -38,6 +38,12 @@ void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points)
 }
 
 namespace {
+// s: how far past the newest wheel sample its motion is extrapolated. The Create's driver publishes at its
+// loop rate (10 Hz by default) and its messages can reach us after the scan they bracket.
+constexpr double kWheelExtrapolation = 0.25;
+// Bound on the samples kept while no scan arrives (a laser that stopped): ~2 min at 66 Hz.
+constexpr std::size_t kMaxWheelSamples = 8192;
+
 // The scan without its points beyond (range_max − margin), into *out; false (out untouched) when nothing
 // would be left out or fewer than min_points would remain (open space: match everything).
 bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_points, PreprocessedScan* out) {
@@ -62,6 +68,45 @@ bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_point
 }
 
 }  // namespace
+
+void LaserOdometry::addWheelOdometry(double stamp, const Pose2D& pose) {
+  if (!std::isfinite(stamp) || !pose.vector().allFinite()) return;
+  if (!wheels_.empty() && stamp <= wheels_.back().stamp) wheels_.clear();  // a new time line (bag looped)
+  wheels_.push_back({stamp, pose});
+  // Keep the newest sample at or before the last scan: the next scan's motion starts there.
+  while (wheels_.size() > 2 && initialized_ && wheels_[1].stamp <= last_stamp_) wheels_.pop_front();
+  while (wheels_.size() > kMaxWheelSamples) wheels_.pop_front();
+}
+
+bool LaserOdometry::wheelPoseAt(double t, Pose2D* pose) const {
+  if (wheels_.size() < 2 || t < wheels_.front().stamp || t > wheels_.back().stamp + kWheelExtrapolation) return false;
+  // The pair around t (the last two past the end: extrapolation at their velocity).
+  std::size_t i = 1;
+  while (i + 1 < wheels_.size() && wheels_[i].stamp < t) ++i;
+  const WheelSample& a = wheels_[i - 1];
+  const WheelSample& b = wheels_[i];
+  const double f = (t - a.stamp) / (b.stamp - a.stamp);
+  *pose = Pose2D(a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
+                 normalizeAngle(a.pose.theta + f * normalizeAngle(b.pose.theta - a.pose.theta)));
+  return true;
+}
+
+bool LaserOdometry::wheelMotion(double from, double to, Pose2D* motion) const {
+  Pose2D a, b;
+  if (!wheelPoseAt(from, &a) || !wheelPoseAt(to, &b)) return false;
+  *motion = between(a, b);
+  return true;
+}
+
+Pose2D LaserOdometry::priorDelta(double stamp, bool* from_wheels) const {
+  const double dt = stamp - last_stamp_;
+  Pose2D d;
+  *from_wheels = dt > 0.0 && wheelMotion(last_stamp_, stamp, &d);
+  if (*from_wheels) return d;
+  // Constant velocity; after a long gap the last velocity says nothing.
+  if (dt > 0.0 && dt <= config_.max_prior_gap) return Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
+  return Pose2D();
+}
 
 OdometryUpdate LaserOdometry::process(const PreprocessedScan& scan, const LaserMount& mount) {
   OdometryUpdate u = processInFrame(scan, mount);
@@ -93,11 +138,13 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   if (!scan.ok() || static_cast<int>(base_points.size()) < config_.min_points) {
     // Nothing to match: propagate with the velocity prior (bounded by the gap rule) and say so.
     const double dt = initialized_ ? scan.stamp - last_stamp_ : 0.0;
-    if (initialized_ && dt > 0.0 && dt <= config_.max_prior_gap) {
-      const Pose2D d(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
-      pose_ = pose_ * d;
-      u.delta = d;
-      last_stamp_ = scan.stamp;
+    if (initialized_ && dt > 0.0) {
+      const Pose2D d = priorDelta(scan.stamp, &u.wheel_prior);
+      if (u.wheel_prior || dt <= config_.max_prior_gap) {
+        pose_ = pose_ * d;
+        u.delta = d;
+        last_stamp_ = scan.stamp;
+      }
     }
     if (u.skip_reason.empty()) u.skip_reason = scan.ok() ? "too_few_points" : "malformed_scan";
     u.pose = pose_;
@@ -132,10 +179,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   }
 
   const double dt = scan.stamp - last_stamp_;
-  // Constant-velocity prior; after a long gap the last velocity says nothing.
-  Pose2D prior_delta;
-  if (dt <= config_.max_prior_gap) prior_delta = Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
-  const Pose2D prior = pose_ * prior_delta;
+  const Pose2D prior = pose_ * priorDelta(scan.stamp, &u.wheel_prior);
 
   PreprocessedScan trimmed;
   const bool trim = trimToMatchRange(scan, config_.match_range_margin, config_.min_points, &trimmed);
@@ -153,8 +197,10 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   const double prior_sigma = config_.prior_acceleration > 0.0 && dt > 0.0 && dt <= config_.max_prior_gap
                                  ? 0.5 * config_.prior_acceleration * dt * dt
                                  : -1.0;
-  const bool may_release = config_.prior_release_speed > 0.0 && velocity_.head<2>().norm() < config_.prior_release_speed;
-  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release);
+  // The wheels measure the motion: no release from their prior, and along a corridor the match keeps it.
+  const bool may_release = !u.wheel_prior && config_.prior_release_speed > 0.0 &&
+                           velocity_.head<2>().norm() < config_.prior_release_speed;
+  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release, u.wheel_prior);
   if (!u.match.valid) {
     u.skip_reason = "match_failed";
     pose_ = prior;

@@ -111,7 +111,8 @@ void readOdometryParameters(const ParameterSource& s, LaserOdometryConfig& o, Sc
 }
 
 const std::vector<std::string>& odometryNodeKeys() {
-  static const std::vector<std::string> keys{"base_frame", "odom_frame", "publish_tf", "transform_timeout"};
+  static const std::vector<std::string> keys{"base_frame", "odom_frame", "publish_tf", "transform_timeout",
+                                                "use_wheel_odometry"};
   return keys;
 }
 

@@ -154,7 +154,8 @@ Eigen::Matrix3d ScanMatcher::boundedByWindow(const Eigen::Matrix3d& cov) const {
 
 MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
                                const std::vector<Eigen::Vector2d>& polish_points, const Pose2D& prior,
-                               std::mt19937_64& rng, double prior_sigma_xy, bool allow_prior_release) const {
+                               std::mt19937_64& rng, double prior_sigma_xy, bool allow_prior_release,
+                               bool hold_prior_when_degenerate) const {
   MatchResult r;
   r.pose = prior;
   if (!hasReference() || points.empty() || polish_points.empty()) return r;
@@ -236,7 +237,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
       }
     }
   }
-  if (config_.keep_prior_when_degenerate) {
+  if (config_.keep_prior_when_degenerate || hold_prior_when_degenerate) {
     // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
     // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
     // (LOAM-style solution remapping, Zhang et al. 2016).

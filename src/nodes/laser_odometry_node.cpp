@@ -27,6 +27,10 @@ class LaserOdometryNode {
     odometry_ = std::make_unique<LaserOdometry>(odom_config_);
     odom_pub_ = nh.advertise<nav_msgs::Odometry>(names::kOdomTopic, 20);
     scan_sub_ = nh.subscribe(names::kScanTopic, 20, &LaserOdometryNode::onScan, this);
+    if (use_wheel_odometry_) {
+      wheel_sub_ = nh.subscribe(names::kWheelOdomTopic, 100, &LaserOdometryNode::onWheelOdometry, this);
+      ROS_INFO("laser_odometry_node: wheel odometry from '%s'", wheel_sub_.getTopic().c_str());
+    }
     ROS_INFO("laser_odometry_node: publishing %s -> %s from '%s' (resampling %s, %d points)", odom_frame_.c_str(),
              base_frame_.c_str(), scan_sub_.getTopic().c_str(), resamplingMethodName(odom_config_.resampling),
              odom_config_.resampling_budget);
@@ -38,6 +42,7 @@ class LaserOdometryNode {
     pnh.param<std::string>("odom_frame", odom_frame_, names::kOdomFrame);
     pnh.param("publish_tf", publish_tf_, true);
     pnh.param("transform_timeout", transform_timeout_, 0.2);
+    pnh.param("use_wheel_odometry", use_wheel_odometry_, false);
     try {
       const RosParameterSource source(pnh);
       readOdometryParameters(source, odom_config_, pre_config_);
@@ -81,6 +86,16 @@ class LaserOdometryNode {
     mount_known_ = true;
     mount_frame_ = laser_frame;
     return true;
+  }
+
+  void onWheelOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+    const Pose2D pose = poseFromMsg(msg->pose.pose);
+    if (!pose.vector().allFinite()) {
+      ROS_WARN_THROTTLE(5.0, "laser_odometry_node: wheel odometry with a non-finite pose ignored");
+      return;
+    }
+    if (++wheel_messages_ == 1) ROS_INFO("laser_odometry_node: first wheel odometry message received");
+    odometry_->addWheelOdometry(msg->header.stamp.toSec(), pose);
   }
 
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg) {
@@ -151,6 +166,7 @@ class LaserOdometryNode {
   std::string base_frame_, odom_frame_;
   bool publish_tf_ = true;
   double transform_timeout_ = 0.2;
+  bool use_wheel_odometry_ = false;
   LaserOdometryConfig odom_config_;
   ScanPreprocessorConfig pre_config_;
 
@@ -161,6 +177,8 @@ class LaserOdometryNode {
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::Publisher odom_pub_;
   ros::Subscriber scan_sub_;
+  ros::Subscriber wheel_sub_;
+  std::size_t wheel_messages_ = 0;
   LaserMount mount_;
   bool mount_known_ = false;
   std::string mount_frame_;

@@ -71,6 +71,23 @@ bool serializedTfMessageFits(const std::uint8_t* data, std::size_t size, std::st
   return true;
 }
 
+bool serializedOdometryFits(const std::uint8_t* data, std::size_t size, std::string* why) {
+  // nav_msgs/Odometry: header (uint32 seq, time, string frame_id), string child_frame_id, pose (7 float64)
+  // with its float64[36] covariance, twist (6 float64) with its float64[36] covariance.
+  std::size_t at = 0;
+  std::uint64_t n = 0;
+  auto fail = [&](const std::string& what) {
+    if (why) *why = what + " (record of " + std::to_string(size) + " bytes)";
+    return false;
+  };
+  if (!skip(size, &at, 1, 12)) return fail("header cut short");
+  if (!readLength(data, size, &at, &n) || !skip(size, &at, n, 1)) return fail("frame_id length " + std::to_string(n) + " does not fit");
+  if (!readLength(data, size, &at, &n) || !skip(size, &at, n, 1)) return fail("child_frame_id length " + std::to_string(n) + " does not fit");
+  if (!skip(size, &at, 7 + 36 + 6 + 36, 8)) return fail("pose and twist cut short");
+  if (at != size) return fail(std::to_string(size - at) + " bytes left over after the message");
+  return true;
+}
+
 namespace {
 
 /// Reads, checks (`fits`) and deserializes one record of type M; `name` goes into the error message.
@@ -101,6 +118,10 @@ sensor_msgs::LaserScan::Ptr readLaserScan(const rosbag::MessageInstance& m) {
 
 tf2_msgs::TFMessage::Ptr readTfMessage(const rosbag::MessageInstance& m) {
   return readChecked<tf2_msgs::TFMessage>(m, "TFMessage", serializedTfMessageFits);
+}
+
+nav_msgs::Odometry::Ptr readOdometry(const rosbag::MessageInstance& m) {
+  return readChecked<nav_msgs::Odometry>(m, "Odometry", serializedOdometryFits);
 }
 
 }  // namespace laser_dpslam

@@ -53,6 +53,10 @@ const char* kUsage =
     "                                               the SLAM)\n"
     "                      [--loops N]              (replay the bag N times, as rosbag play -l would: time\n"
     "                                               goes back at each loop and everything starts over)\n"
+    "                      [--wheel-odom TOPIC]     (the wheels' nav_msgs/Odometry in the bag, e.g. /wheel_odom:\n"
+    "                                               their motion between two scans replaces the odometry's\n"
+    "                                               constant-velocity prediction, as laser_odometry_node does\n"
+    "                                               with use_wheel_odometry)\n"
     "Outputs are written at the end, stats.json last; a failed run (e.g. a corrupted bag) writes none.\n"
     "When scan time goes backwards (a looped bag) the odometry and the SLAM start over, as the nodes\n"
     "do, and the outputs describe the part after the last such reset.\n";
@@ -70,6 +74,7 @@ struct Args {
   std::string memory_log;
   std::string slam_log;
   std::string motion_tum;
+  std::string wheel_odom;
   int loops = 1;
 };
 
@@ -109,6 +114,7 @@ Args parseArgs(int argc, char** argv) {
     else if (f == "--memory-log") a.memory_log = next();
     else if (f == "--slam-log") a.slam_log = next();
     else if (f == "--motion-tum") a.motion_tum = next();
+    else if (f == "--wheel-odom") a.wheel_odom = next();
     else if (f == "--loops") {
       const double v = parseNumber(f, next());
       if (v < 1 || v > 1e6 || v != std::floor(v)) usageError("--loops expects a positive integer");
@@ -136,6 +142,24 @@ void progress(std::size_t done, std::size_t total) {
   std::fprintf(stdout, "\r[%s%s] %zu/%zu scans", std::string(filled, '#').c_str(),
                std::string(width - filled, ' ').c_str(), done, total);
   std::fflush(stdout);
+}
+
+/// The topic with and without its leading slash (a bag may hold either).
+std::vector<std::string> withAndWithoutSlash(const std::string& topic) {
+  if (!topic.empty() && topic[0] == '/') return {topic, topic.substr(1)};
+  return {topic, "/" + topic};
+}
+
+/// " /a /b" for the bag's topics of `type`, or " none".
+std::string topicsOfType(const rosbag::Bag& bag, const std::string& type) {
+  std::set<std::string> found;
+  rosbag::View all(bag);
+  for (const auto* c : all.getConnections()) {
+    if (c->datatype == type) found.insert(c->topic);
+  }
+  std::string list;
+  for (const auto& t : found) list += " " + t;
+  return list.empty() ? " none" : list;
 }
 
 }  // namespace
@@ -232,6 +256,7 @@ int main(int argc, char** argv) {
   std::vector<double> odom_ms;
   std::map<std::string, int> skipped;
   int matched = 0, bad = 0, time_resets = 0;
+  std::size_t wheel_messages = 0;
   bool have_stamp = false;
   double first_stamp = 0.0, last_stamp = 0.0, previous_stamp = 0.0;
   double earlier_segments = 0.0;  // s of data before the last time reset
@@ -254,29 +279,37 @@ int main(int argc, char** argv) {
   const double cpu0 = processCpuSeconds();
 
   try {
-    // Accept the topic with or without its leading slash.
-    std::vector<std::string> topics{args.scan_topic};
-    if (!args.scan_topic.empty() && args.scan_topic[0] == '/') topics.push_back(args.scan_topic.substr(1));
-    else topics.push_back("/" + args.scan_topic);
+    const std::vector<std::string> scan_topics = withAndWithoutSlash(args.scan_topic);
+    const std::vector<std::string> wheel_topics =
+        args.wheel_odom.empty() ? std::vector<std::string>() : withAndWithoutSlash(args.wheel_odom);
     // From time 0, not View's default TIME_MIN: logs without time (DP-SLAM) start at 0.
-    rosbag::View view(bag, rosbag::TopicQuery(topics), ros::Time(0, 0), ros::TIME_MAX);
-    per_loop = view.size();
+    per_loop = rosbag::View(bag, rosbag::TopicQuery(scan_topics), ros::Time(0, 0), ros::TIME_MAX).size();
     total = per_loop * static_cast<std::size_t>(args.loops);
     if (total == 0) {
-      std::set<std::string> scan_topics;
-      rosbag::View all(bag);
-      for (const auto* c : all.getConnections()) {
-        if (c->datatype == "sensor_msgs/LaserScan") scan_topics.insert(c->topic);
-      }
-      std::string list;
-      for (const auto& t : scan_topics) list += " " + t;
       std::cerr << "dpslam_offline: no messages on " << args.scan_topic << " in '" << args.bag
-                << "'; LaserScan topics in the bag:" << (list.empty() ? " none" : list) << " (use --scan-topic)\n";
+                << "'; LaserScan topics in the bag:" << topicsOfType(bag, "sensor_msgs/LaserScan") << " (use --scan-topic)\n";
       return 1;
     }
+    if (!wheel_topics.empty() &&
+        rosbag::View(bag, rosbag::TopicQuery(wheel_topics), ros::Time(0, 0), ros::TIME_MAX).size() == 0) {
+      std::cerr << "dpslam_offline: --wheel-odom: no messages on " << args.wheel_odom << " in '" << args.bag
+                << "'; Odometry topics in the bag:" << topicsOfType(bag, "nav_msgs/Odometry") << "\n";
+      return 1;
+    }
+    std::vector<std::string> topics = scan_topics;
+    topics.insert(topics.end(), wheel_topics.begin(), wheel_topics.end());
+    rosbag::View view(bag, rosbag::TopicQuery(topics), ros::Time(0, 0), ros::TIME_MAX);
 
     for (int loop = 0; loop < args.loops; ++loop) {
       for (const rosbag::MessageInstance& m : view) {
+        if (!wheel_topics.empty() && (m.getTopic() == wheel_topics[0] || m.getTopic() == wheel_topics[1])) {
+          // Wheel odometry in bag order, as the node receives it: a scan sees the samples before it.
+          if (const nav_msgs::Odometry::ConstPtr w = readOdometry(m)) {
+            odometry.addWheelOdometry(w->header.stamp.toSec(), poseFromMsg(w->pose.pose));
+            ++wheel_messages;
+          }
+          continue;
+        }
         ++done;
         sensor_msgs::LaserScan::ConstPtr msg = readLaserScan(m);
         if (!msg) {
@@ -460,6 +493,7 @@ int main(int argc, char** argv) {
     json += "  \"resampling\": " + jsonString(resamplingMethodName(odom_config.resampling)) + ",\n";
     json += std::string("  \"mode\": ") + (slam ? "\"slam\"" : "\"odometry-only\"") + ",\n";
     json += "  \"loops\": " + std::to_string(args.loops) + ",\n";
+    json += "  \"wheel_odometry_messages\": " + std::to_string(wheel_messages) + ",\n";
     json += "  \"time_resets\": " + std::to_string(time_resets) + ",\n";
     json += "  \"skipped\": " + jsonCounts(skipped) + "\n}\n";
     // Last: a stats.json means the run completed and every other output was written.
