@@ -34,15 +34,17 @@ class LaserOdometryNode {
 
  private:
   void readParameters(ros::NodeHandle& pnh) {
-    pnh.param<std::string>("base_frame", base_frame_, names::kBaseFrame);
-    pnh.param<std::string>("odom_frame", odom_frame_, names::kOdomFrame);
-    pnh.param("publish_tf", publish_tf_, true);
-    pnh.param("transform_timeout", transform_timeout_, 0.2);
     try {
       const RosParameterSource source(pnh);
-      readOdometryParameters(source, odom_config_, pre_config_);
-      source.markKnown(odometryNodeKeys());
+      OdometryNodeSettings settings;
+      readOdometryNodeParameters(source, settings);
       for (const std::string& m : source.unknownKeys()) ROS_WARN("laser_odometry_node: %s", m.c_str());
+      base_frame_ = settings.base_frame;
+      odom_frame_ = settings.odom_frame;
+      publish_tf_ = settings.publish_tf;
+      transform_timeout_ = settings.transform_timeout;
+      odom_config_ = settings.odometry;
+      pre_config_ = settings.preprocessing;
     } catch (const std::exception& e) {
       ROS_FATAL("laser_odometry_node: %s", e.what());
       throw;

@@ -152,10 +152,8 @@ int main(int argc, char** argv) {
     for (const auto& path : args.configs) {
       const YamlParameterSource source = YamlParameterSource::load(path);
       readOdometryParameters(source, odom_config, pre_config);
+      // The nodes' own keys (frames, TF) are read too, so count as known, but unused here.
       readDpSlamParameters(source, slam_config);
-      // The nodes' own keys belong in the same files (config/*.yaml): known, unused here.
-      source.markKnown(odometryNodeKeys());
-      source.markKnown(dpslamNodeKeys());
       for (const std::string& m : source.unknownKeys()) std::cerr << "dpslam_offline: warning: " << path << ": " << m << "\n";
     }
     if (args.has_seed) {
