@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
+#include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -162,4 +165,65 @@ TEST(ParameterRegistry, TheCommittedDocIsTheGeneratedOne) {
   committed << in.rdbuf();
   EXPECT_EQ(committed.str(), parametersMarkdown())
       << "doc/parameters.md is stale: rosrun laser_dpslam parameter_docs --out doc/parameters.md";
+}
+
+namespace {
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// "0.3 m" -> "0.3", "[1.0, 0.5] m" -> "[1.0, 0.5]", "0 m: the scan's" -> "0".
+std::string leadingValue(const std::string& text) {
+  if (!text.empty() && text[0] == '[') return text.substr(0, text.find(']') + 1);
+  return text.substr(0, text.find_first_of(" :"));
+}
+
+bool sameValue(const std::string& a, const std::string& b) {
+  char *end_a = nullptr, *end_b = nullptr;
+  const double x = std::strtod(a.c_str(), &end_a), y = std::strtod(b.c_str(), &end_b);
+  if (*end_a == '\0' && *end_b == '\0' && !a.empty() && !b.empty()) return x == y;
+  return a == b;
+}
+}  // namespace
+
+// README's "Parameters that matter" lists exactly the user-facing keys, each under its node and with its default.
+TEST(ParameterRegistry, TheReadmeTableAgreesWithTheRegistries) {
+  const std::string readme = readFile("README.md");
+  const std::size_t begin = readme.find("## Parameters that matter");
+  ASSERT_NE(begin, std::string::npos);
+  const std::string section = readme.substr(begin, readme.find("\n## ", begin + 1) - begin);
+  std::map<std::string, ParameterInfo> odometry, slam;
+  for (const ParameterInfo& p : describeParameters(odometryParameters())) odometry[p.name] = p;
+  for (const ParameterInfo& p : describeParameters(dpslamParameters())) slam[p.name] = p;
+
+  std::set<std::string> listed;
+  const std::regex row(R"(\| (odometry|SLAM|both) \| ([^|]*) \|)");
+  const std::regex entry(R"(`([a-z_]+)` \(([^)]*)\))");
+  for (std::sregex_iterator r(section.begin(), section.end(), row), end; r != end; ++r) {
+    const std::string node = (*r)[1], keys = (*r)[2];
+    for (std::sregex_iterator e(keys.begin(), keys.end(), entry); e != end; ++e) {
+      const std::string key = (*e)[1], value = leadingValue((*e)[2]);
+      listed.insert(key);
+      std::vector<const std::map<std::string, ParameterInfo>*> registries;
+      if (node != "SLAM") registries.push_back(&odometry);
+      if (node != "odometry") registries.push_back(&slam);
+      for (const auto* registry : registries) {
+        const auto it = registry->find(key);
+        ASSERT_NE(it, registry->end()) << key << " (" << node << ") is not a parameter of that node";
+        EXPECT_FALSE(it->second.advanced) << key << " is advanced";
+        EXPECT_TRUE(sameValue(value, it->second.default_value)) << key << ": README " << value << ", code "
+                                                                 << it->second.default_value;
+      }
+    }
+  }
+  for (const auto* registry : {&odometry, &slam}) {
+    for (const auto& [name, info] : *registry) {
+      if (!info.advanced) {
+        EXPECT_TRUE(listed.count(name)) << name << " is user-facing but not in the README's table";
+      }
+    }
+  }
 }
