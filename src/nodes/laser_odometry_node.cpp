@@ -101,12 +101,12 @@ class LaserOdometryNode {
     const OdometryUpdate u = odometry_->process(pre, mount_);
     const double ms = 1e3 * (threadCpuSeconds() - t0);
 
-    if (u.skip_reason == "time_backwards") {
+    if (u.skip_reason == OdometrySkipReason::kTimeBackwards) {
       ROS_WARN("laser_odometry_node: scan time went backwards (bag looped?): odometry reset to the identity");
     } else if (!u.ok) {
       ROS_WARN_THROTTLE(5.0, "laser_odometry_node: scan skipped (%s, %zu valid beams); pose propagated",
-                        u.skip_reason.c_str(), pre.counts.valid);
-      if (u.skip_reason == "duplicate_stamp") return;  // nothing new to publish for this time
+                        toString(u.skip_reason), pre.counts.valid);
+      if (u.skip_reason == OdometrySkipReason::kDuplicateStamp) return;  // nothing new to publish for this time
     }
     ROS_DEBUG("laser_odometry_node: score %.3f matched %.2f%s%s DE %d evals, %.3f ms", u.match.score_per_point,
               u.match.matched_fraction, u.match.degenerate ? " degenerate" : "", u.match.weak ? " weak" : "",
