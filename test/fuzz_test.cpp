@@ -145,7 +145,7 @@ TEST(Fuzz, MalformedScansThroughOdometryAndSlamNeverPoisonTheSlam) {
     previous = stamp;
     OdometryUpdate u;
     ASSERT_NO_THROW(u = odometry.process(pre, mount)) << "scan " << i;
-    if (u.skip_reason == "duplicate_stamp") continue;  // nothing new for this time
+    if (u.skip_reason == OdometrySkipReason::kDuplicateStamp) continue;  // nothing new for this time
     const Pose2D delta = has_last && !u.reset ? between(last_odom, u.pose) : Pose2D();
     last_odom = u.pose;
     has_last = true;

@@ -62,7 +62,7 @@ TEST(LaserOdometry, TracksASimulatedLoopWithSmallDrift) {
   const Pose2D start = run.truth.front().pose;
   for (std::size_t i = 0; i < run.scans.size(); ++i) {
     const OdometryUpdate u = odom.process(preprocessScan(run.scans[i], ScanPreprocessorConfig()), LaserMount());
-    ASSERT_TRUE(u.ok) << "scan " << i << ": " << u.skip_reason;
+    ASSERT_TRUE(u.ok) << "scan " << i << ": " << toString(u.skip_reason);
     const Pose2D truth = between(start, run.truth[i].pose);  // odometry starts at the identity
     max_err = std::max(max_err, std::hypot(u.pose.x - truth.x, u.pose.y - truth.y));
     if (i > 0) {
@@ -91,7 +91,7 @@ TEST(LaserOdometry, AlignToWallsMatchesAlongTheWallsAndReportsInTheOdomFrame) {
   const Pose2D start = run.truth.front().pose;
   for (std::size_t i = 0; i < run.scans.size(); ++i) {
     const OdometryUpdate u = odom.process(preprocessScan(run.scans[i], ScanPreprocessorConfig()), LaserMount());
-    ASSERT_TRUE(u.ok) << "scan " << i << ": " << u.skip_reason;
+    ASSERT_TRUE(u.ok) << "scan " << i << ": " << toString(u.skip_reason);
     if (i == 0) {
       EXPECT_NEAR(u.pose.x, 0.0, 1e-12);
       EXPECT_NEAR(u.pose.y, 0.0, 1e-12);
@@ -147,9 +147,9 @@ TEST(LaserOdometry, BadScansAreSkippedAndNeverCorruptThePose) {
     EXPECT_TRUE(u.pose.vector().allFinite());
     EXPECT_TRUE(u.pose_covariance.allFinite());
     if (i % 10 == 5) {
-      EXPECT_EQ(u.skip_reason, "too_few_points");
+      EXPECT_EQ(u.skip_reason, OdometrySkipReason::kTooFewPoints);
     } else if (i % 10 == 7) {
-      EXPECT_EQ(u.skip_reason, "malformed_scan");
+      EXPECT_EQ(u.skip_reason, OdometrySkipReason::kMalformedScan);
     } else {
       EXPECT_TRUE(u.ok) << i;
     }
@@ -165,9 +165,9 @@ TEST(LaserOdometry, TimeGoingBackwardsResetsAndDuplicatesAreSkipped) {
   for (std::size_t i = 0; i < 30; ++i) odom.process(preprocessScan(run.scans[i], ScanPreprocessorConfig()), LaserMount());
   EXPECT_GT(std::hypot(odom.pose().x, odom.pose().y), 0.05);
   const OdometryUpdate dup = odom.process(preprocessScan(run.scans[29], ScanPreprocessorConfig()), LaserMount());
-  EXPECT_EQ(dup.skip_reason, "duplicate_stamp");
+  EXPECT_EQ(dup.skip_reason, OdometrySkipReason::kDuplicateStamp);
   const OdometryUpdate back = odom.process(preprocessScan(run.scans[0], ScanPreprocessorConfig()), LaserMount());
-  EXPECT_EQ(back.skip_reason, "time_backwards");
+  EXPECT_EQ(back.skip_reason, OdometrySkipReason::kTimeBackwards);
   EXPECT_TRUE(back.reset);
   EXPECT_EQ(back.pose.x, 0.0);
   EXPECT_EQ(back.pose.y, 0.0);
@@ -238,7 +238,7 @@ TEST(LaserOdometry, RangeMarginLeavesTheFarthestPointsOutOfTheMatch) {
     LaserOdometry odom(c);
     odom.process(first, LaserMount());
     const OdometryUpdate u = odom.process(second, LaserMount());
-    EXPECT_TRUE(u.ok) << u.skip_reason;
+    EXPECT_TRUE(u.ok) << toString(u.skip_reason);
     return u.points_used;
   };
   const int all = static_cast<int>(second.points.size());
@@ -554,4 +554,15 @@ TEST(LaserOdometry, WheelsCarryTheEstimateThroughABlankCorridorWithAStop) {
     EXPECT_LT(worst, bound) << "seed " << seed;
     RecordProperty("seed" + std::to_string(seed) + "_worst_mm", static_cast<int>(1000.0 * worst));
   }
+}
+
+// The skip reasons keep the words the logs, the match log and stats.json have always used.
+TEST(LaserOdometry, SkipReasonsPrintAsTheirLogWords) {
+  EXPECT_STREQ(toString(OdometrySkipReason::kNone), "");
+  EXPECT_STREQ(toString(OdometrySkipReason::kTooFewPoints), "too_few_points");
+  EXPECT_STREQ(toString(OdometrySkipReason::kMalformedScan), "malformed_scan");
+  EXPECT_STREQ(toString(OdometrySkipReason::kTimeBackwards), "time_backwards");
+  EXPECT_STREQ(toString(OdometrySkipReason::kDuplicateStamp), "duplicate_stamp");
+  EXPECT_STREQ(toString(OdometrySkipReason::kMatchFailed), "match_failed");
+  EXPECT_EQ(OdometryUpdate().skip_reason, OdometrySkipReason::kNone);
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -67,35 +68,29 @@ TEST(ParameterSource, TheReadersFlagAMisspeltKey) {
 // Every key of the shipped files is read by its node: none is reported.
 TEST(ParameterSource, TheShippedFilesHoldNoUnknownKey) {
   const YamlParameterSource odometry = YamlParameterSource::load("config/laser_odometry.yaml");
-  LaserOdometryConfig o;
-  ScanPreprocessorConfig p;
-  readOdometryParameters(odometry, o, p);
-  odometry.markKnown(odometryNodeKeys());
+  OdometryNodeSettings o;
+  readOdometryNodeParameters(odometry, o);
   EXPECT_TRUE(odometry.unknownKeys().empty()) << odometry.unknownKeys().front();
 
   const YamlParameterSource slam = YamlParameterSource::load("config/dpslam.yaml");
-  DpSlamConfig c;
-  readDpSlamParameters(slam, c);
-  slam.markKnown(dpslamNodeKeys());
+  DpSlamNodeSettings c;
+  readDpSlamNodeParameters(slam, c);
   EXPECT_TRUE(slam.unknownKeys().empty()) << slam.unknownKeys().front();
 }
 
-// The shipped files document every parameter: each key a reader asks for is in its file (a key missing
-// there would leave its default undocumented, and the defaults test could not see it).
-TEST(ParameterSource, TheShippedFilesHoldEveryKeyTheReadersRead) {
+// The readers ask for exactly the registry's keys: none is read past it (and so undocumented).
+TEST(ParameterSource, TheReadersReadExactlyTheRegistrysKeys) {
   const YamlParameterSource empty = yaml("{}");
-  LaserOdometryConfig o;
-  ScanPreprocessorConfig p;
-  readOdometryParameters(empty, o, p);
-  const std::vector<std::string> odometry = YamlParameterSource::load("config/laser_odometry.yaml").keys();
-  for (const std::string& k : empty.knownKeys()) {
-    EXPECT_NE(std::find(odometry.begin(), odometry.end(), k), odometry.end()) << k << " missing in config/laser_odometry.yaml";
-  }
+  OdometryNodeSettings o;
+  readOdometryNodeParameters(empty, o);
+  std::set<std::string> odometry;
+  for (const auto& p : odometryParameters()) odometry.insert(p.name);
+  EXPECT_EQ(empty.knownKeys(), odometry);
+
   const YamlParameterSource empty_slam = yaml("{}");
-  DpSlamConfig c;
-  readDpSlamParameters(empty_slam, c);
-  const std::vector<std::string> slam = YamlParameterSource::load("config/dpslam.yaml").keys();
-  for (const std::string& k : empty_slam.knownKeys()) {
-    EXPECT_NE(std::find(slam.begin(), slam.end(), k), slam.end()) << k << " missing in config/dpslam.yaml";
-  }
+  DpSlamNodeSettings c;
+  readDpSlamNodeParameters(empty_slam, c);
+  std::set<std::string> slam;
+  for (const auto& p : dpslamParameters()) slam.insert(p.name);
+  EXPECT_EQ(empty_slam.knownKeys(), slam);
 }

@@ -26,7 +26,7 @@ namespace laser_dpslam {
 
 class WorkerPool;
 
-/// Every SLAM parameter; names, units and defaults are mirrored in config/dpslam.yaml.
+/// Every SLAM parameter; their keys, units and ranges are in the registry of dpslam_parameters.cpp.
 struct DpSlamConfig {
   // --- Particle filter ---
   int particles = 30;               ///< P

@@ -1,17 +1,39 @@
-// The SLAM's parameters: one table, read from any ParameterSource (YAML file or ROS). Names and units
-// are documented in config/dpslam.yaml (which test/dpslam_parameters_test.cpp keeps equal to the defaults).
+// The SLAM node's parameters: one registry (parameter_registry.h) from which the reader, the check of
+// config/dpslam.yaml and doc/parameters.md come. Adding a key is one entry in src/core/dpslam_parameters.cpp;
+// its default is the settings struct's.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "laser_dpslam/dpslam.h"
+#include "laser_dpslam/parameter_registry.h"
 #include "laser_dpslam/parameter_source.h"
+#include "laser_dpslam/scan_preprocessor.h"
 
 namespace laser_dpslam {
 
-/// Overwrites the fields whose keys are present; throws std::invalid_argument naming the parameter when a
-/// value is of the wrong type or out of its valid range.
-void readDpSlamParameters(const ParameterSource& source, DpSlamConfig& config);
+/// Everything dpslam_node is configured with.
+struct DpSlamNodeSettings {
+  std::string map_frame = "map";
+  std::string odom_frame = "odom";
+  std::string base_frame = "base_link";
+  double map_update_interval = 2.0;  ///< s of data time
+  bool publish_particles = true;
+  double transform_timeout = 0.2;  ///< s
+  ScanPreprocessorConfig preprocessing;  ///< only min_range and max_range are parameters
+  DpSlamConfig slam;
+};
 
-/// The keys dpslam_node reads itself (frames, publishing, TF, range limits), beside readDpSlamParameters's.
-const std::vector<std::string>& dpslamNodeKeys();
+/// Every key dpslam_node reads, in documentation order.
+const std::vector<Parameter<DpSlamNodeSettings>>& dpslamParameters();
+
+/// Overwrites the fields whose keys are present and checks them together; throws std::invalid_argument
+/// naming the key, the value and its range when a value is of the wrong type or out of range.
+void readDpSlamNodeParameters(const ParameterSource& source, DpSlamNodeSettings& settings);
+
+/// The same for the SLAM alone (dpslam_offline): the node's own keys are read, and so count as known, but
+/// not kept.
+void readDpSlamParameters(const ParameterSource& source, DpSlamConfig& config);
 
 }  // namespace laser_dpslam

@@ -89,10 +89,17 @@ struct LaserOdometryConfig {
   std::uint64_t seed = 1;            ///< seed of the DE random generator
 };
 
+/// Why a scan was skipped, or why the odometry started over (kTimeBackwards: the scan is then used).
+enum class OdometrySkipReason { kNone, kTooFewPoints, kMalformedScan, kTimeBackwards, kDuplicateStamp, kMatchFailed };
+
+/// "" for kNone, else "too_few_points", "malformed_scan", "time_backwards", "duplicate_stamp", "match_failed":
+/// the words the logs, the match log and stats.json use.
+const char* toString(OdometrySkipReason reason);
+
 /// What one scan produced.
 struct OdometryUpdate {
   bool ok = false;                    ///< false: the scan was skipped (see skip_reason); pose propagated
-  std::string skip_reason;            ///< "too_few_points", "time_backwards", "duplicate_stamp", "match_failed"
+  OdometrySkipReason skip_reason = OdometrySkipReason::kNone;
   bool reset = false;                 ///< the odometry was reset (first scan, or time went backwards)
   double stamp = 0.0;
   Pose2D pose;                        ///< odom → base_link

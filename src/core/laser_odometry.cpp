@@ -7,6 +7,18 @@
 
 namespace laser_dpslam {
 
+const char* toString(OdometrySkipReason reason) {
+  switch (reason) {
+    case OdometrySkipReason::kNone: return "";
+    case OdometrySkipReason::kTooFewPoints: return "too_few_points";
+    case OdometrySkipReason::kMalformedScan: return "malformed_scan";
+    case OdometrySkipReason::kTimeBackwards: return "time_backwards";
+    case OdometrySkipReason::kDuplicateStamp: return "duplicate_stamp";
+    case OdometrySkipReason::kMatchFailed: return "match_failed";
+  }
+  return "unknown";
+}
+
 LaserOdometry::LaserOdometry(const LaserOdometryConfig& config)
     : config_(config), matcher_(config.matcher), rng_(config.seed) {}
 
@@ -140,9 +152,9 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   if (initialized_ && scan.stamp < last_stamp_) {
     // Time went backwards (a bag looped): start over rather than match across the jump.
     reset();
-    u.skip_reason = "time_backwards";
+    u.skip_reason = OdometrySkipReason::kTimeBackwards;
   } else if (initialized_ && scan.stamp == last_stamp_) {
-    u.skip_reason = "duplicate_stamp";
+    u.skip_reason = OdometrySkipReason::kDuplicateStamp;
     u.pose = pose_;
     u.pose_covariance = pose_covariance_;
     return u;
@@ -160,7 +172,9 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
         last_stamp_ = scan.stamp;
       }
     }
-    if (u.skip_reason.empty()) u.skip_reason = scan.ok() ? "too_few_points" : "malformed_scan";
+    if (u.skip_reason == OdometrySkipReason::kNone) {
+      u.skip_reason = scan.ok() ? OdometrySkipReason::kTooFewPoints : OdometrySkipReason::kMalformedScan;
+    }
     u.pose = pose_;
     u.pose_covariance = pose_covariance_;
     u.velocity = velocity_;
@@ -216,7 +230,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
                            velocity_.head<2>().norm() < config_.prior_release_speed;
   u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release, u.wheel_prior);
   if (!u.match.valid) {
-    u.skip_reason = "match_failed";
+    u.skip_reason = OdometrySkipReason::kMatchFailed;
     pose_ = prior;
     previous_scan_ = scan;
     last_flow_ = RangeFlow();

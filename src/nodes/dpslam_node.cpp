@@ -55,18 +55,18 @@ class DpSlamNode {
 
  private:
   void readParameters(ros::NodeHandle& pnh) {
-    pnh.param<std::string>("map_frame", map_frame_, names::kMapFrame);
-    pnh.param<std::string>("odom_frame", odom_frame_, names::kOdomFrame);
-    pnh.param<std::string>("base_frame", base_frame_, names::kBaseFrame);
-    pnh.param("map_update_interval", map_update_interval_, 2.0);
-    pnh.param("publish_particles", publish_particles_, true);
-    pnh.param("transform_timeout", transform_timeout_, 0.2);
-    pnh.param("min_range", pre_config_.min_range, 0.0);
-    pnh.param("max_range", pre_config_.max_range, 0.0);
     const RosParameterSource source(pnh);
-    readDpSlamParameters(source, slam_config_);
-    source.markKnown(dpslamNodeKeys());
+    DpSlamNodeSettings settings;
+    readDpSlamNodeParameters(source, settings);
     for (const std::string& m : source.unknownKeys()) ROS_WARN("dpslam_node: %s", m.c_str());
+    map_frame_ = settings.map_frame;
+    odom_frame_ = settings.odom_frame;
+    base_frame_ = settings.base_frame;
+    map_update_interval_ = settings.map_update_interval;
+    publish_particles_ = settings.publish_particles;
+    transform_timeout_ = settings.transform_timeout;
+    pre_config_ = settings.preprocessing;
+    slam_config_ = settings.slam;
   }
 
   void onOdom(const nav_msgs::Odometry::ConstPtr& msg) {

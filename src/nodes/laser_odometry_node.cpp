@@ -38,16 +38,18 @@ class LaserOdometryNode {
 
  private:
   void readParameters(ros::NodeHandle& pnh) {
-    pnh.param<std::string>("base_frame", base_frame_, names::kBaseFrame);
-    pnh.param<std::string>("odom_frame", odom_frame_, names::kOdomFrame);
-    pnh.param("publish_tf", publish_tf_, true);
-    pnh.param("transform_timeout", transform_timeout_, 0.2);
-    pnh.param("use_wheel_odometry", use_wheel_odometry_, false);
     try {
       const RosParameterSource source(pnh);
-      readOdometryParameters(source, odom_config_, pre_config_);
-      source.markKnown(odometryNodeKeys());
+      OdometryNodeSettings settings;
+      readOdometryNodeParameters(source, settings);
       for (const std::string& m : source.unknownKeys()) ROS_WARN("laser_odometry_node: %s", m.c_str());
+      base_frame_ = settings.base_frame;
+      odom_frame_ = settings.odom_frame;
+      publish_tf_ = settings.publish_tf;
+      transform_timeout_ = settings.transform_timeout;
+      use_wheel_odometry_ = settings.use_wheel_odometry;
+      odom_config_ = settings.odometry;
+      pre_config_ = settings.preprocessing;
     } catch (const std::exception& e) {
       ROS_FATAL("laser_odometry_node: %s", e.what());
       throw;
@@ -114,12 +116,12 @@ class LaserOdometryNode {
     const OdometryUpdate u = odometry_->process(pre, mount_);
     const double ms = 1e3 * (threadCpuSeconds() - t0);
 
-    if (u.skip_reason == "time_backwards") {
+    if (u.skip_reason == OdometrySkipReason::kTimeBackwards) {
       ROS_WARN("laser_odometry_node: scan time went backwards (bag looped?): odometry reset to the identity");
     } else if (!u.ok) {
       ROS_WARN_THROTTLE(5.0, "laser_odometry_node: scan skipped (%s, %zu valid beams); pose propagated",
-                        u.skip_reason.c_str(), pre.counts.valid);
-      if (u.skip_reason == "duplicate_stamp") return;  // nothing new to publish for this time
+                        toString(u.skip_reason), pre.counts.valid);
+      if (u.skip_reason == OdometrySkipReason::kDuplicateStamp) return;  // nothing new to publish for this time
     }
     ROS_DEBUG("laser_odometry_node: score %.3f matched %.2f%s%s DE %d evals, %.3f ms", u.match.score_per_point,
               u.match.matched_fraction, u.match.degenerate ? " degenerate" : "", u.match.weak ? " weak" : "",

@@ -176,10 +176,8 @@ int main(int argc, char** argv) {
     for (const auto& path : args.configs) {
       const YamlParameterSource source = YamlParameterSource::load(path);
       readOdometryParameters(source, odom_config, pre_config);
+      // The nodes' own keys (frames, TF) are read too, so count as known, but unused here.
       readDpSlamParameters(source, slam_config);
-      // The nodes' own keys belong in the same files (config/*.yaml): known, unused here.
-      source.markKnown(odometryNodeKeys());
-      source.markKnown(dpslamNodeKeys());
       for (const std::string& m : source.unknownKeys()) std::cerr << "dpslam_offline: warning: " << path << ": " << m << "\n";
     }
     if (args.has_seed) {
@@ -348,7 +346,7 @@ int main(int argc, char** argv) {
         if (!args.match_log.empty()) {
           char line[512];
           std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g,%.4g,%.4g,%.4g,%d,%.4f,%d\n",
-                        scan.stamp, u.ok, u.skip_reason.c_str(), u.pose.x, u.pose.y, u.pose.theta, u.delta.x, u.delta.y,
+                        scan.stamp, u.ok, toString(u.skip_reason), u.pose.x, u.pose.y, u.pose.theta, u.delta.x, u.delta.y,
                         u.delta.theta, u.match.score_per_point, u.match.matched_fraction, u.match.degenerate, u.match.weak,
                         u.match.de_generations, u.match.de_evaluations, u.match.newton_iterations, u.points_used,
                         u.new_keyframe, ms, u.delta_covariance(0, 0), u.delta_covariance(1, 1), u.delta_covariance(2, 2),
@@ -361,8 +359,9 @@ int main(int argc, char** argv) {
         if (u.reset && !odom_poses.empty()) start_over(odom_poses.back().stamp, scan.stamp);
         if (odom_poses.empty()) first_stamp = scan.stamp;
         if (!u.ok) {
-          ++skipped[pre.ok() ? u.skip_reason : "malformed_scan"];
-          if (u.skip_reason == "time_backwards" || u.skip_reason == "duplicate_stamp" || !pre.ok()) {
+          ++skipped[pre.ok() ? toString(u.skip_reason) : "malformed_scan"];
+          if (u.skip_reason == OdometrySkipReason::kTimeBackwards ||
+              u.skip_reason == OdometrySkipReason::kDuplicateStamp || !pre.ok()) {
             if (show_progress && done % 20 == 0) progress(done, total);
             continue;
           }

@@ -18,10 +18,8 @@ constexpr const char* kParticlesTopic = "particles";
 constexpr const char* kDynamicMapService = "dynamic_map";
 constexpr const char* kSaveMapService = "save_map";
 
-// Default frames (REP-105); each node has a parameter to change them.
-constexpr const char* kOdomFrame = "odom";
-constexpr const char* kBaseFrame = "base_link";
-constexpr const char* kMapFrame = "map";
+// Frames are parameters: their defaults (REP-105) are in the nodes' settings (odometry_parameters.h,
+// dpslam_parameters.h).
 
 }  // namespace names
 }  // namespace laser_dpslam
