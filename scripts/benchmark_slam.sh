@@ -6,10 +6,19 @@
 # what one core of this machine sustains), peak memory, ancestry-tree size.
 # Error: MIT CSAIL — the relations metric (all 1172 relations, and those <= 10 s apart); demo — ATE RMSE
 # against bags/demo_ground_truth.tum; the other logs have no ground truth (look at their map.png).
-# Usage: scripts/benchmark_slam.sh [--particles "30 10 60"] [DATASETS_DIR]
+# --wheel-odom: the logs that carry wheel odometry (/wheel_odom: MIT CSAIL, mines, loop5) run with
+# `dpslam_offline --wheel-odom /wheel_odom` (rows "NAME+wheels"); the others are left out.
+# Usage: scripts/benchmark_slam.sh [--particles "30 10 60"] [--wheel-odom] [DATASETS_DIR]
 set -euo pipefail
 PARTICLES="30 10 60"
-if [[ "${1:-}" == "--particles" ]]; then PARTICLES="$2"; shift 2; fi
+WHEELS=0
+while [[ "${1:-}" == --* ]]; do
+  case "$1" in
+    --particles) PARTICLES="$2"; shift 2 ;;
+    --wheel-odom) WHEELS=1; shift ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh" > /dev/null
 DATA="${1:-$REPO/../shared/datasets}"
 OUT="$REPO/out/benchmark_slam"
@@ -26,12 +35,17 @@ BAGS[demo]="$REPO/bags/demo.bag"
 
 printf "%-16s %5s %6s %8s %8s %8s %7s %7s %6s  %s\n" dataset P scans "slam ms" "p95 ms" "CPU ms" "RT x CPU" "RSS MB" "tree" "error"
 for name in $(printf "%s\n" "${!BAGS[@]}" | sort); do
+  extra=() label=$name suffix=""
+  if ((WHEELS)); then
+    [[ $name == demo || $name == scan_tools-demo ]] && continue  # no wheel odometry in these
+    extra=(--wheel-odom /wheel_odom) label="$name+wheels" suffix="-wheels"
+  fi
   for p in $PARTICLES; do
-    dir="$OUT/$name-p$p"
+    dir="$OUT/$name-p$p$suffix"
     mkdir -p "$dir"
     printf "particles: %s\nthreads: 1\n" "$p" > "$dir/config.yaml"
     if ! rosrun laser_dpslam dpslam_offline --bag "${BAGS[$name]}" --out "$dir" --config "$dir/config.yaml" \
-         --quiet 2> "$dir/stderr.txt" > /dev/null; then
+         "${extra[@]}" --quiet 2> "$dir/stderr.txt" > /dev/null; then
       echo "$name P=$p: dpslam_offline failed, see $dir/stderr.txt"
       continue
     fi
@@ -45,7 +59,7 @@ for name in $(printf "%s\n" "${!BAGS[@]}" | sort); do
       err=$(/usr/bin/python3 -c 'import json,sys; a=json.load(open(sys.argv[1])); print("ATE RMSE %.4f m (max %.3f m) over %.1f m" % (a["ate_rmse_m"], a["ate_max_m"], a["distance_m"]))' "$dir/ate.json")
     fi
     /usr/bin/python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); print("%-16s %5d %6d %8.2f %8.2f %8.2f %7.1f %7.0f %6d  %s" % (sys.argv[2], s["particles"], s["scans"], s["slam_ms"]["median"], s["slam_ms"]["p95"], 1e3 * s["cpu_s"] / max(1, s["scans"]), s["data_duration_s"] / max(1e-9, s["cpu_s"]), s["peak_rss_mb"], s.get("tree_nodes", -1), sys.argv[3]))' \
-      "$dir/stats.json" "$name" "$err"
+      "$dir/stats.json" "$label" "$err"
   done
 done
 echo "(slam ms: CPU per scan of the SLAM step; CPU ms: the whole run's process CPU per scan; RT x CPU: data time / process CPU; one thread; outputs in $OUT)"
