@@ -100,9 +100,12 @@ class LookupCache {
  private:
   friend class DpSlamMap;
   static constexpr int kTileCells = 64 * 64;
+  /// A cell's row is valid when its stamp is the iteration's; the two side by side share a cache line.
   struct TileRows {
-    std::uint32_t stamp[kTileCells];
-    std::uint32_t row[kTileCells];
+    struct {
+      std::uint32_t stamp;
+      std::uint32_t row;
+    } cells[kTileCells];
   };
   std::vector<int> slot_nodes_;
   std::vector<int> parent_;  ///< snapshot of the tree's parents, by node ID
@@ -278,9 +281,9 @@ class DpSlamMap : public AncestryHooks {
   /// Moves the cursor to the tile of (ix, iy) (creating it when `create`); false if it does not exist.
   bool seek(Cursor& cur, int ix, int iy, LookupCache& cache, bool create);
   bool seek(Cursor& cur, int ix, int iy, LookupCache& cache) const;
-  /// Entry index slot sees in the cursor's cell (-1 = unknown).
-  int resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const;
-  int visibleCached(int tile, int cell, int slot, LookupCache& cache) const;
+  /// The entry slot sees in the cursor's cell (nullptr = unknown).
+  MapEntry* resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const;
+  const MapEntry* visibleCached(int tile, int cell, int slot, LookupCache& cache) const;
   void buildRow(int tile, int cell, LookupCache& cache) const;
   static void setRowSlot(LookupCache& cache, int tile, int cell, int slot, int value);
 
