@@ -246,6 +246,7 @@ class DpSlamMap : public AncestryHooks {
 
  private:
   struct Cell {
+    MapEntry* entries = nullptr;  ///< the block's address (blocks never move): one load less per look-up
     std::uint32_t block = 0;
     std::uint16_t size = 0;
     std::uint8_t cls = 0xFF;  ///< size class of the block (capacity 1 << cls); 0xFF = none
@@ -265,6 +266,7 @@ class DpSlamMap : public AncestryHooks {
   int ensureTile(int ix, int iy);
   static int cellInTile(int ix, int iy) { return ((iy & (kTileSize - 1)) << kTileShift) | (ix & (kTileSize - 1)); }
   MapEntry* entriesOf(const Cell& c) const;
+  void setBlock(Cell& c, int cls, std::uint32_t block);  ///< c takes block `block` of class `cls`
   /// Appends an entry to the cell (growing its block); returns its slot.
   int appendEntry(int tile, int cell, const MapEntry& e);
   /// Removes the entry at `slot` (swap with the last, fixing the moved entry's back-reference) and

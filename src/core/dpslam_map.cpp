@@ -156,7 +156,13 @@ int DpSlamMap::ensureTile(int ix, int iy) {
   return nid;
 }
 
-MapEntry* DpSlamMap::entriesOf(const Cell& c) const { return c.size ? pool_->at(c.cls, c.block) : nullptr; }
+MapEntry* DpSlamMap::entriesOf(const Cell& c) const { return c.size ? c.entries : nullptr; }
+
+void DpSlamMap::setBlock(Cell& c, int cls, std::uint32_t block) {
+  c.cls = static_cast<std::uint8_t>(cls);
+  c.block = block;
+  c.entries = pool_->at(cls, block);
+}
 
 const MapEntry* DpSlamMap::cellEntries(int ix, int iy, int* n) const {
   const int t = tileId(ix, iy);
@@ -196,28 +202,24 @@ bool DpSlamMap::bounds(int* x0, int* y0, int* x1, int* y1) const {
 int DpSlamMap::appendEntry(int tile, int cell, const MapEntry& e) {
   Cell& c = tiles_[tile]->cells[cell];
   if (c.size == 0) {
-    if (c.cls == 0xFF) {
-      c.cls = 0;
-      c.block = pool_->allocate(0);
-    }
+    if (c.cls == 0xFF) setBlock(c, 0, pool_->allocate(0));
     ++observed_cells_;
   } else if (c.size == (1u << c.cls)) {
     const int ncls = c.cls + 1;
     const std::uint32_t nb = pool_->allocate(ncls);
-    std::memcpy(pool_->at(ncls, nb), pool_->at(c.cls, c.block), sizeof(MapEntry) * c.size);
+    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
     pool_->release(c.cls, c.block);
-    c.cls = static_cast<std::uint8_t>(ncls);
-    c.block = nb;
+    setBlock(c, ncls, nb);
   }
   if (c.size == 0xFFFF) throw std::length_error("DpSlamMap: too many entries in one cell");
-  pool_->at(c.cls, c.block)[c.size] = e;
+  c.entries[c.size] = e;
   ++entries_;
   return c.size++;
 }
 
 void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
   Cell& c = tiles_[tile]->cells[cell];
-  MapEntry* e = pool_->at(c.cls, c.block);
+  MapEntry* e = c.entries;
   const int last = c.size - 1;
   if (slot != last) {
     e[slot] = e[last];
@@ -229,14 +231,14 @@ void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
     pool_->release(c.cls, c.block);
     c.cls = 0xFF;
     c.block = 0;
+    c.entries = nullptr;
     --observed_cells_;
   } else if (c.cls > 0 && c.size <= ((1u << c.cls) >> 2)) {
     const int ncls = c.cls - 1;
     const std::uint32_t nb = pool_->allocate(ncls);
-    std::memcpy(pool_->at(ncls, nb), pool_->at(c.cls, c.block), sizeof(MapEntry) * c.size);
+    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
     pool_->release(c.cls, c.block);
-    c.cls = static_cast<std::uint8_t>(ncls);
-    c.block = nb;
+    setBlock(c, ncls, nb);
   }
 }
 
@@ -246,7 +248,7 @@ void DpSlamMap::removeFromOwner(int owner, std::uint32_t back) {
   if (back != last) {
     list[back] = list[last];
     const EntryRef& r = list[back];
-    pool_->at(tiles_[r.tile]->cells[r.cell].cls, tiles_[r.tile]->cells[r.cell].block)[r.slot].back = back;
+    tiles_[r.tile]->cells[r.cell].entries[r.slot].back = back;
   }
   list.pop_back();
 }
@@ -268,7 +270,7 @@ void DpSlamMap::mergeChildIntoParent(int child, int parent) {
   for (std::size_t i = 0; i < cl.size(); ++i) {
     const int tile = cl[i].tile, cell = cl[i].cell;
     Cell& c = tiles_[tile]->cells[cell];
-    MapEntry* e = pool_->at(c.cls, c.block);
+    MapEntry* e = c.entries;
     int dup = -1;
     for (int j = 0; j < c.size; ++j) {
       if (e[j].owner == parent) {
@@ -286,7 +288,7 @@ void DpSlamMap::mergeChildIntoParent(int child, int parent) {
       removeFromOwner(parent, e[dup].back);
       removeFromCell(tile, cell, dup);  // may move the child's entry: cl[i].slot follows
     }
-    MapEntry& me = pool_->at(c.cls, c.block)[cl[i].slot];
+    MapEntry& me = c.entries[cl[i].slot];
     me.owner = static_cast<std::int16_t>(parent);
     me.back = static_cast<std::uint32_t>(pl.size());
     pl.push_back(cl[i]);
@@ -447,7 +449,7 @@ inline bool DpSlamMap::seek(Cursor& cur, int ix, int iy, LookupCache& cache, boo
 inline MapEntry* DpSlamMap::resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const {
   const Cell& c = cur.t->cells[cell];
   if (c.size == 0) return nullptr;
-  MapEntry* e = pool_->at(c.cls, c.block);
+  MapEntry* e = c.entries;
   if (c.size == 1 && e->owner == cache.root_) return e;  // seen by everyone
   const auto& rc = static_cast<const LookupCache::TileRows*>(cur.rows)->cells[cell];
   if (rc.stamp != cache.stamp_) buildRow(cur.tile, cell, cache);
