@@ -179,9 +179,9 @@ class DpSlam {
   double score(const Pose2D& pose, int slot, LookupCache& cache) const;
   double cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const;
   /// Calls f(i, beam, cache) for every item i < n and every beam of `beams`, beam by beam over a block of
-  /// items (one block per worker): particles close together trace nearly the same cells, so the map
-  /// memory one beam touches stays in the CPU cache from one particle to the next. Per item, the beams
-  /// come in order, so per-item sums are the same as item by item.
+  /// items (all of them on one thread, else a few blocks per worker): particles close together trace
+  /// nearly the same cells, so the map memory one beam touches stays in the CPU cache from one particle to
+  /// the next. Per item, the beams come in order, so per-item sums are the same as item by item.
   template <class F>
   void forEachBeamByBlock(std::size_t n, const std::vector<BaseBeam>& beams, F&& f);
   /// Fills ll[i] with score(chosen[i], slot i) for every particle, beam-major.

@@ -198,7 +198,9 @@ double DpSlam::cheapScore(const Pose2D& pose, int slot, LookupCache& cache) cons
 
 template <class F>
 void DpSlam::forEachBeamByBlock(std::size_t n, const std::vector<BaseBeam>& beams, F&& f) {
-  const std::size_t blocks = std::min<std::size_t>(n, static_cast<std::size_t>(pool_->threads()));
+  // Several blocks per worker when there are workers: the machine may be shared, so balance the load.
+  const std::size_t workers = static_cast<std::size_t>(pool_->threads());
+  const std::size_t blocks = std::min(n, workers == 1 ? std::size_t{1} : 4 * workers);
   if (blocks == 0) return;
   const std::size_t per = (n + blocks - 1) / blocks;
   pool_->run(blocks, [&](std::size_t block, int w) {
