@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -167,10 +168,26 @@ class DpSlam {
     double incidence;  ///< |cos| to the surface normal at the return (1: no return / no fit)
     double nx = 0.0, ny = 0.0;  ///< that normal in the base frame ((0, 0): no return / no fit)
   };
+  /// A pose with its rotation, so that the cosine and sine are computed once per pose, not once per beam.
+  struct PoseFrame {
+    explicit PoseFrame(const Pose2D& p) : pose(p), c(std::cos(p.theta)), s(std::sin(p.theta)) {}
+    Pose2D pose;
+    double c, s;
+  };
   void makeBeams(const PreprocessedScan& scan, const LaserMount& mount);
-  MapBeam toMap(const Pose2D& pose, const BaseBeam& b) const;
+  MapBeam toMap(const PoseFrame& f, const BaseBeam& b) const;
   double score(const Pose2D& pose, int slot, LookupCache& cache) const;
   double cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const;
+  /// Calls f(i, beam, cache) for every item i < n and every beam of `beams`, beam by beam over a block of
+  /// items (all of them on one thread, else a few blocks per worker): particles close together trace
+  /// nearly the same cells, so the map memory one beam touches stays in the CPU cache from one particle to
+  /// the next. Per item, the beams come in order, so per-item sums are the same as item by item.
+  template <class F>
+  void forEachBeamByBlock(std::size_t n, const std::vector<BaseBeam>& beams, F&& f);
+  /// Fills ll[i] with score(chosen[i], slot i) for every particle, beam-major.
+  void scoreAll(const std::vector<Pose2D>& chosen, std::vector<double>& ll);
+  /// Fills cheap[n] with cheapScore(candidates[n], slot n / per_slot), beam-major.
+  void cheapScoreAll(const std::vector<Pose2D>& candidates, int per_slot, std::vector<double>& cheap);
   /// Hill climb of the cheap score from `start` (steps along the particle's own axes).
   Pose2D refine(const Pose2D& start, int slot, LookupCache& cache) const;
   /// Plans the scan writes of `who` (old particles, at `at`, seen through the scoring caches) in parallel.

@@ -100,9 +100,12 @@ class LookupCache {
  private:
   friend class DpSlamMap;
   static constexpr int kTileCells = 64 * 64;
+  /// A cell's row is valid when its stamp is the iteration's; the two side by side share a cache line.
   struct TileRows {
-    std::uint32_t stamp[kTileCells];
-    std::uint32_t row[kTileCells];
+    struct {
+      std::uint32_t stamp;
+      std::uint32_t row;
+    } cells[kTileCells];
   };
   std::vector<int> slot_nodes_;
   std::vector<int> parent_;  ///< snapshot of the tree's parents, by node ID
@@ -243,6 +246,7 @@ class DpSlamMap : public AncestryHooks {
 
  private:
   struct Cell {
+    MapEntry* entries = nullptr;  ///< the block's address (blocks never move): one load less per look-up
     std::uint32_t block = 0;
     std::uint16_t size = 0;
     std::uint8_t cls = 0xFF;  ///< size class of the block (capacity 1 << cls); 0xFF = none
@@ -262,6 +266,7 @@ class DpSlamMap : public AncestryHooks {
   int ensureTile(int ix, int iy);
   static int cellInTile(int ix, int iy) { return ((iy & (kTileSize - 1)) << kTileShift) | (ix & (kTileSize - 1)); }
   MapEntry* entriesOf(const Cell& c) const;
+  void setBlock(Cell& c, int cls, std::uint32_t block);  ///< c takes block `block` of class `cls`
   /// Appends an entry to the cell (growing its block); returns its slot.
   int appendEntry(int tile, int cell, const MapEntry& e);
   /// Removes the entry at `slot` (swap with the last, fixing the moved entry's back-reference) and
@@ -278,9 +283,9 @@ class DpSlamMap : public AncestryHooks {
   /// Moves the cursor to the tile of (ix, iy) (creating it when `create`); false if it does not exist.
   bool seek(Cursor& cur, int ix, int iy, LookupCache& cache, bool create);
   bool seek(Cursor& cur, int ix, int iy, LookupCache& cache) const;
-  /// Entry index slot sees in the cursor's cell (-1 = unknown).
-  int resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const;
-  int visibleCached(int tile, int cell, int slot, LookupCache& cache) const;
+  /// The entry slot sees in the cursor's cell (nullptr = unknown).
+  MapEntry* resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const;
+  const MapEntry* visibleCached(int tile, int cell, int slot, LookupCache& cache) const;
   void buildRow(int tile, int cell, LookupCache& cache) const;
   static void setRowSlot(LookupCache& cache, int tile, int cell, int slot, int value);
 

@@ -161,8 +161,9 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
   }
 }
 
-MapBeam DpSlam::toMap(const Pose2D& pose, const BaseBeam& b) const {
-  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+MapBeam DpSlam::toMap(const PoseFrame& f, const BaseBeam& b) const {
+  const double c = f.c, s = f.s;
+  const Pose2D& pose = f.pose;
   MapBeam m;
   m.ox = pose.x + c * beam_origin_.x() - s * beam_origin_.y();
   m.oy = pose.y + s * beam_origin_.x() + c * beam_origin_.y();
@@ -177,20 +178,55 @@ MapBeam DpSlam::toMap(const Pose2D& pose, const BaseBeam& b) const {
 }
 
 double DpSlam::score(const Pose2D& pose, int slot, LookupCache& cache) const {
+  const PoseFrame f(pose);
   double sum = 0.0;
   for (const BaseBeam& b : score_beams_) {
-    sum += map_.beamLogLikelihood(toMap(pose, b), score_range_, slot, cache, config_.beam);
+    sum += map_.beamLogLikelihood(toMap(f, b), score_range_, slot, cache, config_.beam);
   }
   return sum;
 }
 
 double DpSlam::cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const {
+  const PoseFrame f(pose);
   double sum = 0.0;
   for (const BaseBeam& b : score_beams_) {
     if (b.no_return || b.range >= score_range_) continue;
-    sum += map_.beamEndpointLogLikelihood(toMap(pose, b), config_.cull_window, slot, cache, config_.beam);
+    sum += map_.beamEndpointLogLikelihood(toMap(f, b), config_.cull_window, slot, cache, config_.beam);
   }
   return sum;
+}
+
+template <class F>
+void DpSlam::forEachBeamByBlock(std::size_t n, const std::vector<BaseBeam>& beams, F&& f) {
+  // Several blocks per worker when there are workers: the machine may be shared, so balance the load.
+  const std::size_t workers = static_cast<std::size_t>(pool_->threads());
+  const std::size_t blocks = std::min(n, workers == 1 ? std::size_t{1} : 4 * workers);
+  if (blocks == 0) return;
+  const std::size_t per = (n + blocks - 1) / blocks;
+  pool_->run(blocks, [&](std::size_t block, int w) {
+    const std::size_t first = block * per, last = std::min(n, first + per);
+    for (const BaseBeam& b : beams) {
+      for (std::size_t i = first; i < last; ++i) f(i, b, caches_[w]);
+    }
+  });
+}
+
+void DpSlam::scoreAll(const std::vector<Pose2D>& chosen, std::vector<double>& ll) {
+  std::vector<PoseFrame> frames(chosen.begin(), chosen.end());
+  std::fill(ll.begin(), ll.end(), 0.0);
+  forEachBeamByBlock(chosen.size(), score_beams_, [&](std::size_t i, const BaseBeam& b, LookupCache& cache) {
+    ll[i] += map_.beamLogLikelihood(toMap(frames[i], b), score_range_, static_cast<int>(i), cache, config_.beam);
+  });
+}
+
+void DpSlam::cheapScoreAll(const std::vector<Pose2D>& candidates, int per_slot, std::vector<double>& cheap) {
+  std::vector<PoseFrame> frames(candidates.begin(), candidates.end());
+  std::fill(cheap.begin(), cheap.end(), 0.0);
+  forEachBeamByBlock(candidates.size(), score_beams_, [&](std::size_t n, const BaseBeam& b, LookupCache& cache) {
+    if (b.no_return || b.range >= score_range_) return;
+    cheap[n] += map_.beamEndpointLogLikelihood(toMap(frames[n], b), config_.cull_window, static_cast<int>(n) / per_slot,
+                                               cache, config_.beam);
+  });
 }
 
 Pose2D DpSlam::refine(const Pose2D& start, int slot, LookupCache& cache) const {
@@ -225,13 +261,17 @@ Pose2D DpSlam::refine(const Pose2D& start, int slot, LookupCache& cache) const {
 
 void DpSlam::planWrites(const std::vector<int>& who, const std::vector<Pose2D>& at) {
   writes_.resize(std::max(writes_.size(), at.size()));
-  pool_->run(who.size(), [&](std::size_t k, int w) {
-    const int i = who[k];
+  std::vector<PoseFrame> frames;
+  frames.reserve(who.size());
+  for (int i : who) {
     writes_[i].clear();
-    for (const BaseBeam& b : update_beams_) {
-      map_.planBeam(toMap(at[i], b), config_.trace_max_range, i, caches_[w], config_.free_saturation_distance, writes_[i],
-                    config_.revisit_freeze_map && last_revisit_);
-    }
+    frames.emplace_back(at[i]);
+  }
+  const bool only_unknown = config_.revisit_freeze_map && last_revisit_;
+  forEachBeamByBlock(who.size(), update_beams_, [&](std::size_t k, const BaseBeam& b, LookupCache& cache) {
+    const int i = who[k];
+    map_.planBeam(toMap(frames[k], b), config_.trace_max_range, i, cache, config_.free_saturation_distance, writes_[i],
+                  only_unknown);
   });
 }
 
@@ -345,9 +385,7 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
     // 2. Over-sampling: keep each particle's best candidate by the cheap endpoint score.
     if (K > 1) {
       std::vector<double> cheap(candidates.size());
-      pool_->run(candidates.size(), [&](std::size_t n, int w) {
-        cheap[n] = cheapScore(candidates[n], static_cast<int>(n / K), caches_[w]);
-      });
+      cheapScoreAll(candidates, K, cheap);
       for (int i = 0; i < P; ++i) {
         int best = 0;
         for (int k = 1; k < K; ++k) {
@@ -359,7 +397,7 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
       chosen = candidates;
     }
     // 3. Weights: the full observation model, one result per particle (independent of scheduling).
-    pool_->run(P, [&](std::size_t i, int w) { ll[i] = score(chosen[i], static_cast<int>(i), caches_[w]); });
+    scoreAll(chosen, ll);
   }
   // Tempering: beams are not independent, so the product of their likelihoods is over-confident and
   // depletes the particles; an exponent < 1 keeps more hypotheses alive until a loop closes.

@@ -77,7 +77,7 @@ void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_n
   rows_.clear();
   if (++stamp_ == 0) {  // wrapped: forget every stamp
     for (auto& t : tiles_) {
-      if (t) std::memset(t->stamp, 0, sizeof(t->stamp));
+      if (t) std::memset(t->cells, 0, sizeof(t->cells));
     }
     stamp_ = 1;
   }
@@ -156,7 +156,13 @@ int DpSlamMap::ensureTile(int ix, int iy) {
   return nid;
 }
 
-MapEntry* DpSlamMap::entriesOf(const Cell& c) const { return c.size ? pool_->at(c.cls, c.block) : nullptr; }
+MapEntry* DpSlamMap::entriesOf(const Cell& c) const { return c.size ? c.entries : nullptr; }
+
+void DpSlamMap::setBlock(Cell& c, int cls, std::uint32_t block) {
+  c.cls = static_cast<std::uint8_t>(cls);
+  c.block = block;
+  c.entries = pool_->at(cls, block);
+}
 
 const MapEntry* DpSlamMap::cellEntries(int ix, int iy, int* n) const {
   const int t = tileId(ix, iy);
@@ -196,28 +202,24 @@ bool DpSlamMap::bounds(int* x0, int* y0, int* x1, int* y1) const {
 int DpSlamMap::appendEntry(int tile, int cell, const MapEntry& e) {
   Cell& c = tiles_[tile]->cells[cell];
   if (c.size == 0) {
-    if (c.cls == 0xFF) {
-      c.cls = 0;
-      c.block = pool_->allocate(0);
-    }
+    if (c.cls == 0xFF) setBlock(c, 0, pool_->allocate(0));
     ++observed_cells_;
   } else if (c.size == (1u << c.cls)) {
     const int ncls = c.cls + 1;
     const std::uint32_t nb = pool_->allocate(ncls);
-    std::memcpy(pool_->at(ncls, nb), pool_->at(c.cls, c.block), sizeof(MapEntry) * c.size);
+    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
     pool_->release(c.cls, c.block);
-    c.cls = static_cast<std::uint8_t>(ncls);
-    c.block = nb;
+    setBlock(c, ncls, nb);
   }
   if (c.size == 0xFFFF) throw std::length_error("DpSlamMap: too many entries in one cell");
-  pool_->at(c.cls, c.block)[c.size] = e;
+  c.entries[c.size] = e;
   ++entries_;
   return c.size++;
 }
 
 void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
   Cell& c = tiles_[tile]->cells[cell];
-  MapEntry* e = pool_->at(c.cls, c.block);
+  MapEntry* e = c.entries;
   const int last = c.size - 1;
   if (slot != last) {
     e[slot] = e[last];
@@ -229,14 +231,14 @@ void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
     pool_->release(c.cls, c.block);
     c.cls = 0xFF;
     c.block = 0;
+    c.entries = nullptr;
     --observed_cells_;
   } else if (c.cls > 0 && c.size <= ((1u << c.cls) >> 2)) {
     const int ncls = c.cls - 1;
     const std::uint32_t nb = pool_->allocate(ncls);
-    std::memcpy(pool_->at(ncls, nb), pool_->at(c.cls, c.block), sizeof(MapEntry) * c.size);
+    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
     pool_->release(c.cls, c.block);
-    c.cls = static_cast<std::uint8_t>(ncls);
-    c.block = nb;
+    setBlock(c, ncls, nb);
   }
 }
 
@@ -246,7 +248,7 @@ void DpSlamMap::removeFromOwner(int owner, std::uint32_t back) {
   if (back != last) {
     list[back] = list[last];
     const EntryRef& r = list[back];
-    pool_->at(tiles_[r.tile]->cells[r.cell].cls, tiles_[r.tile]->cells[r.cell].block)[r.slot].back = back;
+    tiles_[r.tile]->cells[r.cell].entries[r.slot].back = back;
   }
   list.pop_back();
 }
@@ -268,7 +270,7 @@ void DpSlamMap::mergeChildIntoParent(int child, int parent) {
   for (std::size_t i = 0; i < cl.size(); ++i) {
     const int tile = cl[i].tile, cell = cl[i].cell;
     Cell& c = tiles_[tile]->cells[cell];
-    MapEntry* e = pool_->at(c.cls, c.block);
+    MapEntry* e = c.entries;
     int dup = -1;
     for (int j = 0; j < c.size; ++j) {
       if (e[j].owner == parent) {
@@ -286,7 +288,7 @@ void DpSlamMap::mergeChildIntoParent(int child, int parent) {
       removeFromOwner(parent, e[dup].back);
       removeFromCell(tile, cell, dup);  // may move the child's entry: cl[i].slot follows
     }
-    MapEntry& me = pool_->at(c.cls, c.block)[cl[i].slot];
+    MapEntry& me = c.entries[cl[i].slot];
     me.owner = static_cast<std::int16_t>(parent);
     me.back = static_cast<std::uint32_t>(pl.size());
     pl.push_back(cl[i]);
@@ -395,11 +397,11 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
     uniform = uniform && out[s] == out[0];
   }
   LookupCache::TileRows& tr = *cache.tiles_[tile];
-  tr.stamp[cell] = cache.stamp_;
+  tr.cells[cell].stamp = cache.stamp_;
   if (uniform && slots > 0) {
-    tr.row[cell] = kUniform | static_cast<std::uint32_t>(out[0] + 1);
+    tr.cells[cell].row = kUniform | static_cast<std::uint32_t>(out[0] + 1);
   } else {
-    tr.row[cell] = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
+    tr.cells[cell].row = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
     cache.rows_.insert(cache.rows_.end(), out, out + slots);
   }
 }
@@ -407,14 +409,14 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
 void DpSlamMap::setRowSlot(LookupCache& cache, int tile, int cell, int slot, int value) {
   if (static_cast<std::size_t>(tile) >= cache.tiles_.size() || !cache.tiles_[tile]) return;
   LookupCache::TileRows& tr = *cache.tiles_[tile];
-  if (tr.stamp[cell] != cache.stamp_) return;  // no row yet: it will be built from the map
+  if (tr.cells[cell].stamp != cache.stamp_) return;  // no row yet: it will be built from the map
   const std::size_t slots = cache.slot_nodes_.size();
-  std::uint32_t word = tr.row[cell];
+  std::uint32_t word = tr.cells[cell].row;
   if (word & kUniform) {  // materialise the row
     const std::int32_t v = static_cast<std::int32_t>(word & ~kUniform) - 1;
     word = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
     cache.rows_.insert(cache.rows_.end(), slots, v);
-    tr.row[cell] = word;
+    tr.cells[cell].row = word;
   }
   cache.rows_[static_cast<std::size_t>(word) * slots + slot] = value;
 }
@@ -444,30 +446,30 @@ inline bool DpSlamMap::seek(Cursor& cur, int ix, int iy, LookupCache& cache, boo
   return static_cast<const DpSlamMap*>(this)->seek(cur, ix, iy, cache);
 }
 
-inline int DpSlamMap::resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const {
+inline MapEntry* DpSlamMap::resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const {
   const Cell& c = cur.t->cells[cell];
-  if (c.size == 0) return -1;
-  if (c.size == 1 && pool_->at(c.cls, c.block)[0].owner == cache.root_) return 0;  // seen by everyone
-  const auto* tr = static_cast<const LookupCache::TileRows*>(cur.rows);
-  if (tr->stamp[cell] != cache.stamp_) buildRow(cur.tile, cell, cache);
-  const std::uint32_t word = tr->row[cell];
-  if (word & kUniform) return static_cast<int>(word & ~kUniform) - 1;
-  return cache.rows_[static_cast<std::size_t>(word) * cache.slot_nodes_.size() + slot];
+  if (c.size == 0) return nullptr;
+  MapEntry* e = c.entries;
+  if (c.size == 1 && e->owner == cache.root_) return e;  // seen by everyone
+  const auto& rc = static_cast<const LookupCache::TileRows*>(cur.rows)->cells[cell];
+  if (rc.stamp != cache.stamp_) buildRow(cur.tile, cell, cache);
+  const std::uint32_t word = rc.row;
+  const int j = (word & kUniform) ? static_cast<int>(word & ~kUniform) - 1
+                                  : cache.rows_[static_cast<std::size_t>(word) * cache.slot_nodes_.size() + slot];
+  return j < 0 ? nullptr : e + j;
 }
 
-int DpSlamMap::visibleCached(int tile, int cell, int slot, LookupCache& cache) const {
+const MapEntry* DpSlamMap::visibleCached(int tile, int cell, int slot, LookupCache& cache) const {
   Cursor cur;
   const Tile& t = *tiles_[tile];
-  if (!seek(cur, t.tx << kTileShift, t.ty << kTileShift, cache)) return -1;
+  if (!seek(cur, t.tx << kTileShift, t.ty << kTileShift, cache)) return nullptr;
   return resolve(cur, cell, slot, cache);
 }
 
 const MapEntry* DpSlamMap::cachedLookup(int ix, int iy, int slot, LookupCache& cache) const {
   const int t = tileId(ix, iy);
   if (t < 0) return nullptr;
-  const int cell = cellInTile(ix, iy);
-  const int j = visibleCached(t, cell, slot, cache);
-  return j < 0 ? nullptr : &pool_->at(tiles_[t]->cells[cell].cls, tiles_[t]->cells[cell].block)[j];
+  return visibleCached(t, cellInTile(ix, iy), slot, cache);
 }
 
 int DpSlamMap::quantizeNormal(double nx, double ny) {
@@ -562,18 +564,21 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
     const bool end = hit && t1 >= length;
     int q = 0;  // the cell's normal, if it has statistics
     if ((normals || !end || only_unknown) && seek(cur, ix, iy, cache)) {
-      const int cell = cellInTile(ix, iy);
-      const int vis = resolve(cur, cell, slot, cache);
-      if (vis >= 0 && only_unknown) return true;
-      if (vis >= 0) {
-        const Cell& c = cur.t->cells[cell];
-        const MapEntry& v = pool_->at(c.cls, c.block)[vis];
-        if (!end && v.hits == 0.0f && v.distance >= saturation) return true;
-        if (normals) q = v.normal;
+      const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache);
+      if (v && only_unknown) return true;
+      if (v) {
+        if (!end && v->hits == 0.0f && v->distance >= saturation) return true;
+        if (normals) q = v->normal;
       }
     }
     if (end && !q) q = beam_normal;  // a new surface cell: the normal it is about to take
-    CellWrite w{ix, iy, static_cast<float>((t1 - t0) * chordFactor(q, b, t1 >= surface_from)), end ? 1.0f : 0.0f};
+    // Filled in place: a CellWrite built on the stack and copied in stalls on store forwarding.
+    out.emplace_back();
+    CellWrite& w = out.back();
+    w.ix = ix;
+    w.iy = iy;
+    w.d = static_cast<float>((t1 - t0) * chordFactor(q, b, t1 >= surface_from));
+    w.hit = end ? 1.0f : 0.0f;
     if (end) {
       w.normal = static_cast<std::uint8_t>(beam_normal);
       const int nq = beam_normal ? beam_normal : q;  // the normal the entry has after this write
@@ -584,7 +589,6 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
         w.offset = static_cast<std::uint8_t>(quantizeOffset(n.c[nq] * px + n.s[nq] * py));
       }
     }
-    out.push_back(w);
     return true;
   });
 }
@@ -598,14 +602,13 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
   for (const CellWrite& w : writes) {
     seek(cur, w.ix, w.iy, cache, true);
     const int cell = cellInTile(w.ix, w.iy);
-    const int vis = resolve(cur, cell, slot, cache);
-    Cell& c = cur.t->cells[cell];
+    MapEntry* vis = resolve(cur, cell, slot, cache);
     MapEntry ne;
     ne.owner = static_cast<std::int16_t>(node);
     ne.normal = w.normal;
     ne.offset = w.offset;
-    if (vis >= 0) {
-      MapEntry& v = pool_->at(c.cls, c.block)[vis];
+    if (vis) {
+      MapEntry& v = *vis;
       if (w.hit == 0.0f && v.hits == 0.0f && v.distance >= saturation) continue;
       const int nq = w.normal ? w.normal : v.normal;
       const std::uint8_t offset = w.offset ? meanOffset(v.normal, v.offset, v.hits, nq, w.offset) : v.offset;
@@ -658,14 +661,10 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
     double mu = mu_unknown;
     int q = 0, k = 0;
     if (seek(cur, ix, iy, cache)) {
-      const int cell = cellInTile(ix, iy);
-      const int vis = resolve(cur, cell, slot, cache);
-      if (vis >= 0) {
-        const Cell& c = cur.t->cells[cell];
-        const MapEntry& v = pool_->at(c.cls, c.block)[vis];
-        mu = v.density();
-        if (normals) q = v.normal;
-        if (offsets) k = v.offset;
+      if (const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache)) {
+        mu = v->density();
+        if (normals) q = v->normal;
+        if (offsets) k = v->offset;
       }
     }
     if (mu == 0.0) return true;
@@ -703,15 +702,11 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                double mu = mu_unknown;
                int q = 0, k = 0;
                if (seek(cur, ix, iy, cache)) {
-                 const int cell = cellInTile(ix, iy);
-                 const int vis = resolve(cur, cell, slot, cache);
-                 if (vis >= 0) {
-                   const Cell& c = cur.t->cells[cell];
-                   const MapEntry& v = pool_->at(c.cls, c.block)[vis];
-                   mu = v.density();
+                 if (const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache)) {
+                   mu = v->density();
                    if (cell_normal_min_cos_ > 0.0) {
-                     q = v.normal;
-                     if (surface_offsets_) k = v.offset;
+                     q = v->normal;
+                     if (surface_offsets_) k = v->offset;
                    }
                  }
                }
