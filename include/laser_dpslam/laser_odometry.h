@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -58,8 +59,10 @@ struct LaserOdometryConfig {
   /// match (same range gate) leaves the velocity along its weak direction as it was: the velocity measured
   /// there carries the robot through a featureless stretch, where each match's small pull back towards the
   /// local map would otherwise slow it down scan after scan. A released prior (prior_release_speed) ends the
-  /// hold: the scan refuted that velocity. 0 = off.
-  double degenerate_hold_time = 10.0;
+  /// hold: the scan refuted that velocity. 0 = off; infinite (the default): until the scan fixes every
+  /// direction again, as a constant-velocity model keeps an unobserved velocity (a time limit made the
+  /// estimate stall in corridors longer than it: generated buildings, doc/experiments.md).
+  double degenerate_hold_time = std::numeric_limits<double>::infinity();
   /// [0, 1]; > 0: where a degenerate match (same range gate) has lines in view that face along its weak
   /// direction (a niche, a door frame, a pillar), the speed along that direction is also measured from how
   /// their ranges changed since the previous scan (measureRangeFlow). When two consecutive flows agree and

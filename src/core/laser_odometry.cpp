@@ -277,7 +277,8 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
                              scan.range_max <= config_.degenerate_velocity_max_range;
     // A released prior was refuted by the scan: nothing left to hold.
     if (u.match.prior_released) constrained_stamp_ = kNoConstrainedMatch;
-    const bool hold = config_.degenerate_hold_time > 0.0 && scan.stamp - constrained_stamp_ <= config_.degenerate_hold_time;
+    const bool hold = config_.degenerate_hold_time > 0.0 && constrained_stamp_ != kNoConstrainedMatch &&
+                      scan.stamp - constrained_stamp_ <= config_.degenerate_hold_time;
     if (short_range && u.match.degenerate) {
       const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
       if (config_.range_flow_gain > 0.0 && previous_scan_.stamp == last_stamp_) {

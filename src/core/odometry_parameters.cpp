@@ -173,7 +173,8 @@ std::vector<Parameter<S>> motionPriorEntries() {
       {"degenerate_hold_time", "motion prior", FIELD(odometry.degenerate_hold_time), "s", atLeast(0),
        "for this long after the last match that fixed every direction, a degenerate match leaves the velocity "
        "along its weak direction as it was (where nothing along a corridor is in range each match pulled a little "
-       "back: the loop building's west corridor lost 0.10-0.36 m); a released prior ends the hold; 0 = off",
+       "back: the loop building's west corridor lost 0.10-0.36 m); a released prior ends the hold; 0 = off; "
+       ".inf (default) = until a match fixes every direction again",
        kAdvanced},
       {"range_flow_gain", "motion prior", FIELD(odometry.range_flow_gain), "-", closedInterval(0, 1),
        "in a degenerate match with lines in view that face along the corridor (a niche, a door frame), the speed "
