@@ -8,7 +8,7 @@
 #   laser   the laser-only path (path_laser.txt: constant speed through blank stretches, stops and speed
 #           changes only where something along the corridor is in view), no wheel odometry
 #   wheels  the wheel path (path_wheels.txt: also stops and speed changes inside blank stretches), with
-#           /wheel_odom passed to dpslam_offline --wheel-odom (skipped with a note while it lacks the option)
+#           /wheel_odom passed to dpslam_offline --wheel-odom
 # Prints one row per run (case, family, metres, odometry ATE, drift %, SLAM ATE) and, per mode, the median /
 # 90th percentile / worst of the drift and the SLAM ATE against the targets.
 # Two fixed seed lists: `bench` to tune on, `holdout` to evaluate only at the end (never tune on it).
