@@ -133,7 +133,8 @@ class LaserOdometry {
   /// between two scan stamps replaces the constant-velocity prediction, and along a direction the scan does
   /// not constrain (a corridor) the match keeps it: the laser decides wherever it sees structure, the wheels
   /// carry the robot where it does not. A stamp not after the last sample's starts a new time line.
-  void addWheelOdometry(double stamp, const Pose2D& pose);
+  /// False (the sample ignored) when the stamp or the pose is not finite.
+  bool addWheelOdometry(double stamp, const Pose2D& pose);
 
   /// odom → base_link (the odom frame is the first pose).
   Pose2D pose() const { return toOdom(pose_); }

@@ -54,6 +54,12 @@ struct Pose2D {
 /// The motion from a to b expressed in a's frame: a⁻¹ ⊕ b.
 inline Pose2D between(const Pose2D& a, const Pose2D& b) { return a.inverse() * b; }
 
+/// The pose a fraction f of the way from a to b (f outside [0, 1] extrapolates): position linearly, heading
+/// along the shorter turn.
+inline Pose2D interpolate(const Pose2D& a, const Pose2D& b, double f) {
+  return Pose2D(a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), normalizeAngle(a.theta + f * normalizeAngle(b.theta - a.theta)));
+}
+
 /// Jacobians of a ⊕ b with respect to a and b, for first-order propagation of pose covariances:
 /// Σ(a ⊕ b) ≈ Ja·Σa·Jaᵀ + Jb·Σb·Jbᵀ.
 inline void composeJacobians(const Pose2D& a, const Pose2D& b, Eigen::Matrix3d* Ja, Eigen::Matrix3d* Jb) {

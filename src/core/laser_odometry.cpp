@@ -95,13 +95,14 @@ bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_point
 
 }  // namespace
 
-void LaserOdometry::addWheelOdometry(double stamp, const Pose2D& pose) {
-  if (!std::isfinite(stamp) || !pose.vector().allFinite()) return;
+bool LaserOdometry::addWheelOdometry(double stamp, const Pose2D& pose) {
+  if (!std::isfinite(stamp) || !pose.vector().allFinite()) return false;
   if (!wheels_.empty() && stamp <= wheels_.back().stamp) wheels_.clear();  // a new time line (bag looped)
   wheels_.push_back({stamp, pose});
   // Keep the newest sample at or before the last scan: the next scan's motion starts there.
   while (wheels_.size() > 2 && initialized_ && wheels_[1].stamp <= last_stamp_) wheels_.pop_front();
   while (wheels_.size() > kMaxWheelSamples) wheels_.pop_front();
+  return true;
 }
 
 bool LaserOdometry::wheelPoseAt(double t, Pose2D* pose) const {
@@ -111,9 +112,7 @@ bool LaserOdometry::wheelPoseAt(double t, Pose2D* pose) const {
   while (i + 1 < wheels_.size() && wheels_[i].stamp < t) ++i;
   const WheelSample& a = wheels_[i - 1];
   const WheelSample& b = wheels_[i];
-  const double f = (t - a.stamp) / (b.stamp - a.stamp);
-  *pose = Pose2D(a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
-                 normalizeAngle(a.pose.theta + f * normalizeAngle(b.pose.theta - a.pose.theta)));
+  *pose = interpolate(a.pose, b.pose, (t - a.stamp) / (b.stamp - a.stamp));
   return true;
 }
 

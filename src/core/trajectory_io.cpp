@@ -118,9 +118,7 @@ bool interpolatePose(const std::vector<StampedPose>& poses, double stamp, Pose2D
   }
   const StampedPose& a = *(hi - 1);
   const StampedPose& b = *hi;
-  const double f = (stamp - a.stamp) / (b.stamp - a.stamp);
-  *pose = Pose2D(a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
-                 normalizeAngle(a.pose.theta + f * normalizeAngle(b.pose.theta - a.pose.theta)));
+  *pose = interpolate(a.pose, b.pose, (stamp - a.stamp) / (b.stamp - a.stamp));
   return true;
 }
 

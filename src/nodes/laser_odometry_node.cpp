@@ -91,13 +91,11 @@ class LaserOdometryNode {
   }
 
   void onWheelOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
-    const Pose2D pose = poseFromMsg(msg->pose.pose);
-    if (!pose.vector().allFinite()) {
-      ROS_WARN_THROTTLE(5.0, "laser_odometry_node: wheel odometry with a non-finite pose ignored");
+    if (!odometry_->addWheelOdometry(msg->header.stamp.toSec(), poseFromMsg(msg->pose.pose))) {
+      ROS_WARN_THROTTLE(5.0, "laser_odometry_node: wheel odometry with a non-finite pose or stamp ignored");
       return;
     }
     if (++wheel_messages_ == 1) ROS_INFO("laser_odometry_node: first wheel odometry message received");
-    odometry_->addWheelOdometry(msg->header.stamp.toSec(), pose);
   }
 
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg) {
