@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "laser_dpslam/floor_plan.h"
+#include "laser_dpslam/sim/floor_plan.h"
 
 namespace laser_dpslam {
 namespace test {

@@ -23,15 +23,15 @@
 #include <mutex>
 
 #include "laser_dpslam/SaveMap.h"
-#include "laser_dpslam/dpslam.h"
-#include "laser_dpslam/dpslam_parameters.h"
-#include "laser_dpslam/occupancy_export.h"
+#include "laser_dpslam/slam/dpslam.h"
+#include "laser_dpslam/slam/dpslam_parameters.h"
+#include "laser_dpslam/export/occupancy_export.h"
 #include "laser_dpslam/ros/msg_conversion.h"
 #include "laser_dpslam/ros/names.h"
 #include "laser_dpslam/ros/ros_parameter_source.h"
 #include "laser_dpslam/ros/tf_wait.h"
-#include "laser_dpslam/scan_preprocessor.h"
-#include "laser_dpslam/trajectory_smoother.h"
+#include "laser_dpslam/scan/scan_preprocessor.h"
+#include "laser_dpslam/slam/trajectory_smoother.h"
 
 namespace laser_dpslam {
 

@@ -32,10 +32,10 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/create_oi.h"
-#include "laser_dpslam/floor_plan.h"
-#include "laser_dpslam/scan_simulator.h"
-#include "laser_dpslam/scip_device.h"
+#include "laser_dpslam/sim/create_oi.h"
+#include "laser_dpslam/sim/floor_plan.h"
+#include "laser_dpslam/sim/scan_simulator.h"
+#include "laser_dpslam/sim/scip_device.h"
 
 using namespace laser_dpslam;
 

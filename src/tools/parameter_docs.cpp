@@ -4,7 +4,7 @@
 #include <iostream>
 #include <string>
 
-#include "laser_dpslam/parameter_docs.h"
+#include "laser_dpslam/common/parameter_docs.h"
 
 namespace {
 const char* kUsage =

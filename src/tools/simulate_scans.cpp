@@ -27,12 +27,12 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/floor_plan.h"
+#include "laser_dpslam/sim/floor_plan.h"
 #include "laser_dpslam/ros/msg_conversion.h"
-#include "laser_dpslam/scan_simulator.h"
-#include "laser_dpslam/sim_path.h"
-#include "laser_dpslam/vector_plan.h"
-#include "laser_dpslam/wheel_odometry_sim.h"
+#include "laser_dpslam/sim/scan_simulator.h"
+#include "laser_dpslam/sim/sim_path.h"
+#include "laser_dpslam/sim/vector_plan.h"
+#include "laser_dpslam/sim/wheel_odometry_sim.h"
 
 namespace fs = std::filesystem;
 using namespace laser_dpslam;

@@ -5,9 +5,9 @@
 #include <geometry_msgs/Transform.h>
 #include <sensor_msgs/LaserScan.h>
 
-#include "laser_dpslam/laser_mount.h"
-#include "laser_dpslam/laser_scan.h"
-#include "laser_dpslam/pose2d.h"
+#include "laser_dpslam/common/laser_mount.h"
+#include "laser_dpslam/common/laser_scan.h"
+#include "laser_dpslam/common/pose2d.h"
 
 namespace laser_dpslam {
 

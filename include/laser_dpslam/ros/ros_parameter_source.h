@@ -3,7 +3,7 @@
 
 #include <ros/node_handle.h>
 
-#include "laser_dpslam/parameter_source.h"
+#include "laser_dpslam/common/parameter_source.h"
 
 namespace laser_dpslam {
 

@@ -1,0 +1,87 @@
+// Normal Distributions Transform of a 2D point set (Biber & Straßer, IROS 2003): four overlapping
+// L×L grids shifted by L/2, a Gaussian per cell with ≥ min_points points, and the score h with its
+// analytic gradient and Hessian (doc/algorithms.md §2).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "laser_dpslam/common/pose2d.h"
+
+namespace laser_dpslam {
+
+struct NdtGridConfig {
+  double cell_size = 0.5;      ///< m, side L of a cell
+  int min_points = 3;          ///< a cell needs this many points to get a Gaussian (thesis: 3)
+  double eigen_ratio = 0.001;  ///< smallest covariance eigenvalue is raised to this × the largest
+  double min_eigen = 1e-5;     ///< m², absolute floor of the eigenvalues (a perfectly straight wall)
+  double point_sigma = 0.0;    ///< m, noise of a matched point; each cell's term is scaled so that such a point at
+                               ///< its true place scores the same on average in a thin (wall) and a fat (corner)
+                               ///< cell; 0 = off (the plain Biber score)
+};
+
+/// One Gaussian of the NDT. The inverse covariance is precomputed: it is what the score needs.
+struct NdtCell {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  double weight = 1.0;  ///< scale of this cell's exp() term (NdtGridConfig::point_sigma)
+  int count = 0;
+  bool valid = false;
+};
+
+/// Score of a moved point set. h is minimised (h = −Σ_i Σ_grids exp(−½ qᵀΣ⁻¹q)).
+struct NdtScore {
+  double h = 0.0;
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
+  int matched = 0;  ///< points with at least one cell within 3σ (Mahalanobis² < 9)
+};
+
+class NdtGrid {
+ public:
+  NdtGrid() = default;
+  NdtGrid(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config) { build(points, config); }
+
+  /// Rebuilds the four grids over the bounding box of `points`.
+  void build(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config);
+
+  /// h at `pose` for `points` given in the moving frame; gradient and Hessian w.r.t. (x, y, θ) when
+  /// `derivatives` is set (Jacobian at the scan-frame point, doc/algorithms.md §2).
+  NdtScore score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points, bool derivatives) const;
+
+  /// Σ over the four grids of exp(−½ qᵀΣ⁻¹q) for one point in the grid's frame (0 … 4).
+  double density(const Eigen::Vector2d& p) const;
+
+  double cellSize() const { return config_.cell_size; }
+  std::size_t validCells() const { return valid_cells_; }
+  bool empty() const { return valid_cells_ == 0; }
+
+  /// Layer k (0..3) is shifted by (k&1, k>>1)·L/2. For tests and the score raster.
+  struct Layer {
+    Eigen::Vector2d origin = Eigen::Vector2d::Zero();  ///< corner of cell (0, 0)
+    int nx = 0, ny = 0;
+    std::vector<NdtCell> cells;                        ///< row-major, index = iy·nx + ix
+    const NdtCell* cellAt(const Eigen::Vector2d& p, double inv_size) const;
+  };
+  const std::array<Layer, 4>& layers() const { return layers_; }
+
+ private:
+  NdtGridConfig config_;
+  std::array<Layer, 4> layers_;
+  std::size_t valid_cells_ = 0;
+};
+
+inline const NdtCell* NdtGrid::Layer::cellAt(const Eigen::Vector2d& p, double inv_size) const {
+  const double fx = (p.x() - origin.x()) * inv_size;
+  const double fy = (p.y() - origin.y()) * inv_size;
+  if (!(fx >= 0.0 && fy >= 0.0)) return nullptr;  // also rejects NaN
+  const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+  if (ix >= nx || iy >= ny) return nullptr;
+  const NdtCell& c = cells[static_cast<std::size_t>(iy) * nx + ix];
+  return c.valid ? &c : nullptr;
+}
+
+}  // namespace laser_dpslam

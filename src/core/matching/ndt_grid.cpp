@@ -1,0 +1,149 @@
+#include "laser_dpslam/matching/ndt_grid.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+
+namespace laser_dpslam {
+
+namespace {
+struct Accumulator {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
+  int n = 0;
+};
+}  // namespace
+
+void NdtGrid::build(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config) {
+  config_ = config;
+  valid_cells_ = 0;
+  for (auto& layer : layers_) {
+    layer.nx = layer.ny = 0;
+    layer.cells.clear();
+  }
+  if (points.empty() || !(config.cell_size > 0.0)) return;
+
+  Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (const auto& p : points) {
+    if (!p.allFinite()) continue;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  if (!lo.allFinite()) return;
+
+  const double L = config.cell_size, inv = 1.0 / L;
+  std::vector<Accumulator> acc;
+  for (int k = 0; k < 4; ++k) {
+    Layer& layer = layers_[k];
+    // Shift by L/2 in x and/or y (Biber & Straßer): every point falls in four cells.
+    const Eigen::Vector2d shift(0.5 * L * (k & 1), 0.5 * L * (k >> 1));
+    layer.origin = (Eigen::Vector2d((std::floor(lo.x() * inv)), std::floor(lo.y() * inv)) * L) - Eigen::Vector2d(L, L) + shift;
+    layer.nx = static_cast<int>(std::floor((hi.x() - layer.origin.x()) * inv)) + 2;
+    layer.ny = static_cast<int>(std::floor((hi.y() - layer.origin.y()) * inv)) + 2;
+    const std::size_t n_cells = static_cast<std::size_t>(layer.nx) * layer.ny;
+    acc.assign(n_cells, Accumulator());
+    for (const auto& p : points) {
+      if (!p.allFinite()) continue;
+      const int ix = static_cast<int>((p.x() - layer.origin.x()) * inv);
+      const int iy = static_cast<int>((p.y() - layer.origin.y()) * inv);
+      if (ix < 0 || iy < 0 || ix >= layer.nx || iy >= layer.ny) continue;
+      Accumulator& a = acc[static_cast<std::size_t>(iy) * layer.nx + ix];
+      a.sum += p;
+      a.sum_sq += p * p.transpose();
+      ++a.n;
+    }
+    layer.cells.assign(n_cells, NdtCell());
+    for (std::size_t i = 0; i < n_cells; ++i) {
+      const Accumulator& a = acc[i];
+      if (a.n < config.min_points) continue;
+      NdtCell& c = layer.cells[i];
+      c.count = a.n;
+      c.mean = a.sum / a.n;
+      // Sample covariance (K − n·μμᵀ)/(n − 1): the minus sign matters (doc/algorithms.md §2, known bug).
+      Eigen::Matrix2d cov = (a.sum_sq - a.n * c.mean * c.mean.transpose()) / (a.n - 1);
+      // Regularise by rebuilding from the eigenvectors with a clamped smallest eigenvalue.
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+      es.computeDirect(cov);  // closed form for 2×2
+      Eigen::Vector2d ev = es.eigenvalues();
+      const double lmax = std::max(ev.maxCoeff(), config.min_eigen);
+      const double floor_ev = std::max(config.eigen_ratio * lmax, config.min_eigen);
+      ev = ev.cwiseMax(floor_ev);
+      if (!ev.allFinite()) continue;
+      const Eigen::Matrix2d& V = es.eigenvectors();
+      c.covariance = V * ev.asDiagonal() * V.transpose();
+      c.information = V * ev.cwiseInverse().asDiagonal() * V.transpose();
+      // A point with isotropic noise σ at its true place scores E[exp(−½qᵀΣ⁻¹q)] = det(I + σ²Σ⁻¹)^(−½)
+      // on average: less in a thin wall cell than in a fat corner cell, so the plain score pulls noisy
+      // scans towards corners, along corridors most of all. The weight undoes that.
+      const double s2 = config.point_sigma * config.point_sigma;
+      c.weight = std::sqrt((1.0 + s2 / ev(0)) * (1.0 + s2 / ev(1)));
+      c.valid = true;
+      ++valid_cells_;
+    }
+  }
+}
+
+double NdtGrid::density(const Eigen::Vector2d& p) const {
+  const double inv = 1.0 / config_.cell_size;
+  double s = 0.0;
+  for (const Layer& layer : layers_) {
+    const NdtCell* c = layer.cellAt(p, inv);
+    if (!c) continue;
+    const Eigen::Vector2d q = p - c->mean;
+    s += c->weight * std::exp(-0.5 * q.dot(c->information * q));
+  }
+  return s;
+}
+
+NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points,
+                        bool derivatives) const {
+  NdtScore out;
+  if (valid_cells_ == 0) return out;
+  const double inv = 1.0 / config_.cell_size;
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  // Accumulated in scalars (this loop is the matcher's hot spot): gradient g0..g2 and the upper
+  // triangle of the symmetric Hessian.
+  double h = 0, g0 = 0, g1 = 0, g2 = 0, H00 = 0, H01 = 0, H02 = 0, H11 = 0, H12 = 0, H22 = 0;
+  for (const auto& a : points) {
+    const double xx = c * a.x() - s * a.y() + pose.x, xy = s * a.x() + c * a.y() + pose.y;
+    // Jacobian column for θ and the only non-zero second derivative (∂²x'/∂θ²), at the scan-frame point.
+    const double jx = -s * a.x() - c * a.y(), jy = c * a.x() - s * a.y();
+    const double hx = -c * a.x() + s * a.y(), hy = -s * a.x() - c * a.y();
+    const Eigen::Vector2d x(xx, xy);
+    bool matched = false;
+    for (const Layer& layer : layers_) {
+      const NdtCell* cell = layer.cellAt(x, inv);
+      if (!cell) continue;
+      const double qx = xx - cell->mean.x(), qy = xy - cell->mean.y();
+      const double a00 = cell->information(0, 0), a01 = cell->information(0, 1), a11 = cell->information(1, 1);
+      const double iqx = a00 * qx + a01 * qy, iqy = a01 * qx + a11 * qy;  // Σ⁻¹q
+      const double m2 = qx * iqx + qy * iqy;
+      if (m2 < 9.0) matched = true;
+      if (m2 > 40.0) continue;  // exp(−20) ≈ 2e-9: no contribution worth an exp()
+      const double e = cell->weight * std::exp(-0.5 * m2);
+      h -= e;
+      if (!derivatives) continue;
+      // g_k = e·qᵀΣ⁻¹J_k with J = [e_x, e_y, j_θ].
+      const double qj = iqx * jx + iqy * jy;
+      g0 += e * iqx;
+      g1 += e * iqy;
+      g2 += e * qj;
+      // H_kl = e·[−(qᵀΣ⁻¹J_k)(qᵀΣ⁻¹J_l) + qᵀΣ⁻¹∂²x'/∂p_k∂p_l + J_lᵀΣ⁻¹J_k]
+      const double ijx = a00 * jx + a01 * jy, ijy = a01 * jx + a11 * jy;  // Σ⁻¹j_θ
+      H00 += e * (a00 - iqx * iqx);
+      H01 += e * (a01 - iqx * iqy);
+      H02 += e * (ijx - iqx * qj);
+      H11 += e * (a11 - iqy * iqy);
+      H12 += e * (ijy - iqy * qj);
+      H22 += e * (jx * ijx + jy * ijy - qj * qj + iqx * hx + iqy * hy);
+    }
+    if (matched) ++out.matched;
+  }
+  out.h = h;
+  out.gradient << g0, g1, g2;
+  out.hessian << H00, H01, H02, H01, H11, H12, H02, H12, H22;
+  return out;
+}
+
+}  // namespace laser_dpslam

@@ -1,0 +1,282 @@
+#include "laser_dpslam/matching/scan_matcher.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace laser_dpslam {
+
+ScanMatcher::ScanMatcher(const ScanMatcherConfig& config) : config_(config) {
+  if (config_.cell_sizes.empty()) throw std::invalid_argument("ScanMatcher: cell_sizes is empty");
+  for (double L : config_.cell_sizes) {
+    if (!(L > 0.0)) throw std::invalid_argument("ScanMatcher: cell sizes must be positive");
+  }
+}
+
+void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points) {
+  grids_.resize(config_.cell_sizes.size());
+  for (std::size_t i = 0; i < grids_.size(); ++i) {
+    NdtGridConfig c = config_.ndt;
+    c.cell_size = config_.cell_sizes[i];
+    grids_[i].build(points, c);
+  }
+  if (config_.use_de) raster_.build(grids_.front(), config_.raster_resolution);
+}
+
+bool ScanMatcher::hasReference() const { return !grids_.empty() && !grids_.back().empty(); }
+
+Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
+                           int* iterations, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis,
+                           const Pose2D* prior, double prior_sigma_xy, NdtScore* final_score) const {
+  const NdtGrid& grid = grids_.at(level);
+  // The motion prior as a quadratic term in h's units, see prior_sigma_xy.
+  const double w = prior ? priorWeight(prior_sigma_xy) : 0.0;
+  // `raw` receives the score without the prior's term.
+  auto score = [&](const Pose2D& p, NdtScore* raw) {
+    NdtScore r = grid.score(p, points, true);
+    *raw = r;
+    if (w > 0.0) {
+      const Eigen::Vector2d d(p.x - prior->x, p.y - prior->y);
+      r.h += 0.5 * w * d.squaredNorm();
+      r.gradient.head<2>() += w * d;
+      r.hessian.topLeftCorner<2, 2>() += w * Eigen::Matrix2d::Identity();
+    }
+    return r;
+  };
+  Pose2D pose = start;
+  NdtScore raw;
+  NdtScore s = score(pose, &raw);
+  int it = 0;
+  for (; it < config_.newton_iterations; ++it) {
+    // Newton with the Hessian made positive definite (doc/algorithms.md §2).
+    Eigen::Matrix3d H = s.hessian;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(H, Eigen::EigenvaluesOnly);
+    const double lmin = es.eigenvalues()(0);
+    if (lmin <= 0.0) H += (1.0 - 1.1 * lmin) * Eigen::Matrix3d::Identity();
+    Eigen::Vector3d delta;
+    if (basis) {
+      // Newton in the subspace: Δ = B (BᵀHB)⁻¹ Bᵀ(−g).
+      const Eigen::MatrixXd Hb = basis->transpose() * H * *basis;
+      delta = -*basis * Hb.ldlt().solve(basis->transpose() * s.gradient);
+    } else {
+      delta = -H.ldlt().solve(s.gradient);
+    }
+    if (!delta.allFinite()) break;
+    // Backtracking: a Newton step on a sum of Gaussians can overshoot.
+    double step = 1.0;
+    bool improved = false;
+    for (int k = 0; k < 6; ++k) {
+      const Pose2D cand(pose.x + step * delta.x(), pose.y + step * delta.y(),
+                        normalizeAngle(pose.theta + step * delta.z()));
+      NdtScore craw;
+      NdtScore cs = score(cand, &craw);
+      if (cs.h <= s.h) {
+        pose = cand;
+        s = cs;
+        raw = craw;
+        improved = true;
+        break;
+      }
+      step *= 0.5;
+    }
+    if (!improved) break;
+    if ((step * delta).head<2>().norm() < config_.newton_tolerance &&
+        std::abs(step * delta.z()) < config_.newton_tolerance) {
+      ++it;
+      break;
+    }
+  }
+  if (iterations) *iterations += it;
+  if (final_score) *final_score = raw;
+  return pose;
+}
+
+bool ScanMatcher::degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* weak) const {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
+  et.computeDirect(Eigen::Matrix2d(0.5 * (hessian.topLeftCorner<2, 2>() + hessian.topLeftCorner<2, 2>().transpose())));
+  *weak = et.eigenvectors().col(0);
+  return !(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12));
+}
+
+Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& r) const {
+  // Σ = α·H⁻¹ + Σ_min (doc/algorithms.md §2): h is not a normalised likelihood, so H⁻¹ alone is
+  // over-confident. H's eigenvalues are floored so that a singular H still gives a finite (large) Σ.
+  const Eigen::Matrix3d Hs = 0.5 * (hessian + hessian.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(Hs);
+  const double floor = 1e-9 * std::max(es.eigenvalues().maxCoeff(), 1e-9);
+  // Degeneracy (corridors, a single wall): a translation direction the scan barely constrains. Say so in
+  // the covariance with a large σ along it, rather than trusting a tiny curvature.
+  Eigen::Vector2d v;
+  r.degenerate = degenerate(Hs, &v);
+  if (r.degenerate) r.weak_direction = v;
+  auto fromEigenvalues = [&](const Eigen::Vector3d& ev) {
+    Eigen::Matrix3d cov = config_.covariance_scale * es.eigenvectors() * ev.cwiseMax(floor).cwiseInverse().asDiagonal() *
+                          es.eigenvectors().transpose();
+    if (r.degenerate) {
+      const double sigma = with_prior ? config_.degenerate_sigma_with_prior : config_.degenerate_sigma;
+      cov.topLeftCorner<2, 2>() += sigma * sigma * v * v.transpose();
+    }
+    cov(0, 0) += config_.min_sigma_xy * config_.min_sigma_xy;
+    cov(1, 1) += config_.min_sigma_xy * config_.min_sigma_xy;
+    cov(2, 2) += config_.min_sigma_theta * config_.min_sigma_theta;
+    if (r.weak) cov *= config_.weak_inflation;
+    return Eigen::Matrix3d(0.5 * (cov + cov.transpose()));
+  };
+  // Where the polish ended on a ridge (H indefinite: h curves down, typically in heading) a negative
+  // eigenvalue is floored to nothing, which says "unknown" along it; the SLAM's proposal spreads its
+  // particles along that direction and is better for it (doc/reliability.md). The pose covariance takes
+  // the curvature's magnitude instead (how fast h changes there: saddle-free, Dauphin et al. 2014), within
+  // the search window.
+  r.bounded_covariance = boundedByWindow(fromEigenvalues(es.eigenvalues().cwiseAbs()));
+  return fromEigenvalues(es.eigenvalues());
+}
+
+Eigen::Matrix3d ScanMatcher::boundedByWindow(const Eigen::Matrix3d& cov) const {
+  // The search knows the pose lies within ±window of the prior (±rescue_window_theta for a retried weak
+  // match), at worst uniformly: σ = w/√3 (in translation no less than degenerate_sigma, the σ a corridor
+  // is given). Translation (by its largest σ, so its direction is kept) and heading are scaled down to
+  // that; the correlations are kept.
+  const double wt = config_.rescue_margin > 0.0 ? std::max(config_.window_theta, config_.rescue_window_theta) : config_.window_theta;
+  const double cap_xy = std::max(config_.window_xy / std::sqrt(3.0), config_.degenerate_sigma);
+  const double cap_theta = wt / std::sqrt(3.0);
+  Eigen::Matrix3d c = 0.5 * (cov + cov.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> et;
+  et.computeDirect(Eigen::Matrix2d(c.topLeftCorner<2, 2>()), Eigen::EigenvaluesOnly);
+  const double sd_xy = std::sqrt(std::max(0.0, et.eigenvalues()(1))), sd_theta = std::sqrt(std::max(0.0, c(2, 2)));
+  const double fxy = sd_xy > cap_xy ? cap_xy / sd_xy : 1.0, ftheta = sd_theta > cap_theta ? cap_theta / sd_theta : 1.0;
+  const Eigen::Vector3d f(fxy, fxy, ftheta);
+  return f.asDiagonal() * c * f.asDiagonal();
+}
+
+MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
+                               const std::vector<Eigen::Vector2d>& polish_points, const Pose2D& prior,
+                               std::mt19937_64& rng, double prior_sigma_xy, bool allow_prior_release,
+                               bool hold_prior_when_degenerate) const {
+  MatchResult r;
+  r.pose = prior;
+  if (!hasReference() || points.empty() || polish_points.empty()) return r;
+
+  // DE over a window around the prior (doc/algorithms.md §3), the prior seeded into the population.
+  auto deSearch = [&](const Eigen::Vector3d& w, std::mt19937_64& rng) {
+    using DE = DifferentialEvolution<3>;
+    DE::Config dc;
+    dc.population = config_.de_population;
+    dc.max_generations = config_.de_generations;
+    dc.F = config_.de_F;
+    dc.CR = config_.de_CR;
+    dc.dither = config_.de_dither;
+    dc.strategy = DE::Strategy::kRand1Bin;
+    dc.spread_tolerance = Eigen::Vector3d(config_.de_spread_xy, config_.de_spread_xy, config_.de_spread_theta);
+    dc.stall_generations = config_.de_stall_generations;
+    const Eigen::Vector3d p0 = prior.vector();
+    // θ is searched unwrapped around the prior; normalised when the pose is formed.
+    auto cost = [&](const Eigen::Vector3d& x) { return raster_.cost(Pose2D(x.x(), x.y(), x.z()), points); };
+    const DE de(dc);
+    const DE::Result res = de.minimize(cost, p0 - w, p0 + w, {p0}, rng);
+    r.de_generations += res.generations;
+    r.de_evaluations += res.evaluations;
+    return Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
+  };
+  // Newton polish coarse to fine, then the exact score at the finest resolution.
+  // (The finest level's polish already scored its final pose: that score is reused.)
+  auto polishAll = [&](Pose2D pose, NdtScore* s, bool with_prior = true) {
+    bool scored = false;
+    for (std::size_t level = 0; level < grids_.size(); ++level) {
+      if (grids_[level].empty()) continue;
+      pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, with_prior ? &prior : nullptr,
+                    prior_sigma_xy, s);
+      scored = level + 1 == grids_.size();
+    }
+    if (!scored) *s = grids_.back().score(pose, polish_points, true);
+    return pose;
+  };
+  const double n = static_cast<double>(polish_points.size());
+  auto scorePerPoint = [&](const NdtScore& s) { return -s.h / (4.0 * n); };  // in [0, 1]
+  auto isWeak = [&](const NdtScore& s) {
+    return scorePerPoint(s) < config_.weak_score || s.matched / n < config_.weak_matched_fraction;
+  };
+  const bool de = config_.use_de && !raster_.empty();
+  NdtScore s;
+  Pose2D pose = polishAll(de ? deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng) : prior, &s);
+  const double prior_sigma = priorSigma(prior_sigma_xy);
+  if (de && prior_sigma > 0.0 && std::hypot(pose.x - prior.x, pose.y - prior.y) > 3.0 * prior_sigma) {
+    // The polish minimises h plus the soft prior, but DE searched h alone (on the raster) and may hand it a
+    // basin far from the prior (a corridor's flat score, a false optimum 0.2 m back). Polish from the prior
+    // too and keep the lower value of that same objective.
+    const double w = priorWeight(prior_sigma_xy);
+    auto objective = [&](const Pose2D& p, const NdtScore& sc) {
+      return sc.h + 0.5 * w * ((p.x - prior.x) * (p.x - prior.x) + (p.y - prior.y) * (p.y - prior.y));
+    };
+    NdtScore ps;
+    const Pose2D from_prior = polishAll(prior, &ps);
+    if (objective(from_prior, ps) < objective(pose, s)) {
+      pose = from_prior;
+      s = ps;
+    }
+  }
+  if (config_.rescue_margin > 0.0 && de && isWeak(s)) {
+    // A weak match is often a wrong one (a fast turn starting: the constant-velocity prior is off and the
+    // search ends on a false optimum). Try the prior itself and a search over a wider window; take one only
+    // if it scores clearly better, so that the flat optima of corridors are not traded for one another.
+    // (Without DE the match already started from the prior: nothing to retry.)
+    // A copy of the generator: a retry leaves the caller's random stream, and so every later match, as it
+    // would be without it.
+    std::mt19937_64 retry_rng = rng;
+    retry_rng.discard(1);
+    const Pose2D wide = deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.rescue_window_theta), retry_rng);
+    for (const Pose2D& st : {prior, wide}) {
+      NdtScore cs;
+      const Pose2D cand = polishAll(st, &cs);
+      if (scorePerPoint(cs) > scorePerPoint(s) + config_.rescue_margin) {
+        pose = cand;
+        s = cs;
+      }
+    }
+  }
+  if (config_.keep_prior_when_degenerate || hold_prior_when_degenerate) {
+    // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
+    // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
+    // (LOAM-style solution remapping, Zhang et al. 2016).
+    Eigen::Vector2d v;
+    if (degenerate(s.hessian, &v)) {
+      const Eigen::Vector2d d(pose.x - prior.x, pose.y - prior.y);
+      const Eigen::Vector2d xy = Eigen::Vector2d(pose.x, pose.y) - v * v.dot(d);
+      Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
+      basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
+      pose = polish(polish_points, Pose2D(xy.x(), xy.y(), pose.theta), grids_.size() - 1, &r.newton_iterations, &basis);
+      s = grids_.back().score(pose, polish_points, true);
+    }
+  }
+  Eigen::Vector2d weak;
+  if (allow_prior_release && prior_sigma > 0.0 && degenerate(s.hessian, &weak)) {
+    // Along a corridor the soft prior holds the pose to the constant-velocity guess. When that guess is
+    // wrong (the robot starts to move while the estimate says it is at rest), the velocity smoothing
+    // follows the held motion only slowly and metres are lost in seconds (the loop building's start). The
+    // scan then fits clearly better where it really is: polish again without the prior and take that
+    // when it scores higher and lies well outside the prior's σ along the weak direction.
+    NdtScore fs;
+    const Pose2D free = polishAll(pose, &fs, false);
+    if (scorePerPoint(fs) > scorePerPoint(s) + config_.prior_release_margin &&
+        std::abs(weak.dot(Eigen::Vector2d(free.x - pose.x, free.y - pose.y))) > config_.prior_release_sigmas * prior_sigma) {
+      pose = free;
+      s = fs;
+      r.prior_released = true;
+    }
+  }
+  r.pose = pose;
+
+  r.hessian = s.hessian;
+  r.score_per_point = scorePerPoint(s);
+  r.matched_fraction = static_cast<double>(s.matched) / n;
+  r.weak = isWeak(s);
+  r.covariance = covarianceFrom(s.hessian, prior_sigma > 0.0, r);
+  r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
+  if (!r.valid) r.pose = prior;
+  return r;
+}
+
+}  // namespace laser_dpslam

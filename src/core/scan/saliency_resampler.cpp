@@ -1,0 +1,262 @@
+#include "laser_dpslam/scan/saliency_resampler.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+
+namespace laser_dpslam {
+
+namespace {
+
+double rangeOf(const PreprocessedScan& scan, std::size_t i) {
+  return scan.ranges.size() == scan.points.size() ? scan.ranges[i] : scan.points[i].norm();
+}
+
+long beamOf(const PreprocessedScan& scan, std::size_t i) {
+  return scan.beams.size() == scan.points.size() ? scan.beams[i] : static_cast<long>(i);
+}
+
+// Angle of a line's normal, folded into [0, π) (a surface seen from either side is the same orientation).
+double foldAngle(double a) {
+  a = std::fmod(a, M_PI);
+  if (a < 0.0) a += M_PI;
+  return a >= M_PI ? 0.0 : a;
+}
+
+// Soft (linear) binning into a circular histogram over [0, π): no aliasing at bin borders.
+void binOf(double angle, int bins, int& b0, int& b1, double& w1) {
+  const double x = angle / M_PI * bins - 0.5;
+  const double f = std::floor(x);
+  w1 = x - f;
+  b0 = ((static_cast<int>(f) % bins) + bins) % bins;
+  b1 = (b0 + 1) % bins;
+}
+
+}  // namespace
+
+SaliencyFeatures computeSaliency(const PreprocessedScan& scan, const SaliencyConfig& cfg) {
+  const std::size_t n = scan.points.size();
+  const std::vector<Eigen::Vector2d>& p = scan.points;
+  SaliencyFeatures f;
+  f.segment.assign(n, 0);
+  f.curvature.assign(n, 0.0);
+  f.normal_angle.assign(n, -1.0);
+  f.rarity.assign(n, 0.0);
+  f.edge.assign(n, EdgeType::kNone);
+  f.score.assign(n, 0.0);
+  if (n == 0) return f;
+
+  // §4.2 Segments and edges. Near endpoint of a jump = occluding edge; far endpoint = shadow (the
+  // first background point behind an occluder moves with the viewpoint). Shadow wins when a point is
+  // both (a mixed pixel floating between two surfaces).
+  std::vector<char> occluding(n, 0), shadow(n, 0);
+  int seg = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    const double ra = rangeOf(scan, i - 1), rb = rangeOf(scan, i);
+    const long gap = std::abs(beamOf(scan, i) - beamOf(scan, i - 1)) - 1;
+    if (std::abs(rb - ra) > cfg.jump_abs + cfg.jump_rel * std::min(ra, rb)) {
+      ++seg;
+      (ra < rb ? occluding[i - 1] : occluding[i]) = 1;
+      (ra < rb ? shadow[i] : shadow[i - 1]) = 1;
+    } else if (gap > cfg.max_beam_gap) {
+      ++seg;
+    }
+    f.segment[i] = seg;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    f.edge[i] = shadow[i] ? EdgeType::kShadow : occluding[i] ? EdgeType::kOccluding : EdgeType::kNone;
+
+  // §4.3 Curvature from a PCA of the neighbourhood (same segment, within the radius, at most ±k beams):
+  // c = λ2/(λ1+λ2) is 0 on a line and 0.5 on an isotropic blob. Each neighbour is weighted by the arc
+  // length it stands for (half its two gaps), so the PCA sees the surface, not the sampling density:
+  // unweighted, the denser wall of a corner dominates and the curvature peak slides off the corner.
+  std::vector<double> arc(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    double w = 0.0;
+    if (i > 0 && f.segment[i - 1] == f.segment[i]) w += 0.5 * (p[i] - p[i - 1]).norm();
+    if (i + 1 < n && f.segment[i + 1] == f.segment[i]) w += 0.5 * (p[i + 1] - p[i]).norm();
+    arc[i] = std::min(w, std::max(cfg.neighbour_radius, 0.0)) + 1e-9;  // > 0: isolated points still count
+  }
+  const std::size_t k = static_cast<std::size_t>(std::max(1, cfg.neighbours));
+  const double r2 = cfg.neighbour_radius * cfg.neighbour_radius;
+  double c_max = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j0 = i >= k ? i - k : 0;
+    const std::size_t j1 = std::min(n - 1, i + k);
+    double sw = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
+    int cnt = 0;
+    std::size_t other = i;  // some neighbour other than i, for the 2-point case
+    for (std::size_t j = j0; j <= j1; ++j) {
+      if (f.segment[j] != f.segment[i]) continue;
+      const Eigen::Vector2d d = p[j] - p[i];  // centred on p_i for numerical stability
+      if (d.squaredNorm() > r2) continue;
+      const double w = arc[j];
+      sw += w;
+      sx += w * d.x();
+      sy += w * d.y();
+      sxx += w * d.x() * d.x();
+      sxy += w * d.x() * d.y();
+      syy += w * d.y() * d.y();
+      ++cnt;
+      if (j != i) other = j;
+    }
+    if (cnt >= 3) {
+      const double mx = sx / sw, my = sy / sw;
+      const double a = sxx / sw - mx * mx, b = sxy / sw - mx * my, d = syy / sw - my * my;
+      const double tr = a + d;
+      const double disc = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
+      const double l2 = std::max(0.0, 0.5 * tr - disc);
+      if (tr > 1e-12) f.curvature[i] = std::min(0.5, l2 / tr);
+      // Major axis at 0.5·atan2(2b, a−d); the normal is perpendicular to it.
+      f.normal_angle[i] = foldAngle(0.5 * std::atan2(2.0 * b, a - d) + 0.5 * M_PI);
+    } else if (cnt == 2) {
+      const Eigen::Vector2d d = p[other] - p[i];
+      if (d.squaredNorm() > 0.0) f.normal_angle[i] = foldAngle(std::atan2(d.y(), d.x()) + 0.5 * M_PI);
+    }
+    c_max = std::max(c_max, f.curvature[i]);
+  }
+
+  // §4.4 Orientation rarity: points facing a rare direction (a corridor's end wall) constrain the
+  // direction the rest of the scan leaves unobservable.
+  const int bins = std::max(1, cfg.orientation_bins);
+  std::vector<double> hist(bins, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (f.normal_angle[i] < 0.0) continue;
+    int b0, b1;
+    double w1;
+    binOf(f.normal_angle[i], bins, b0, b1, w1);
+    hist[b0] += 1.0 - w1;
+    hist[b1] += w1;
+  }
+  const double h_max = *std::max_element(hist.begin(), hist.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    if (f.normal_angle[i] < 0.0 || h_max <= 0.0) continue;
+    int b0, b1;
+    double w1;
+    binOf(f.normal_angle[i], bins, b0, b1, w1);
+    const double h = (1.0 - w1) * hist[b0] + w1 * hist[b1];
+    f.rarity[i] = std::clamp(1.0 - h / h_max, 0.0, 1.0);
+  }
+
+  // §4.5 Score.
+  for (std::size_t i = 0; i < n; ++i) {
+    const double c = c_max > 0.0 ? f.curvature[i] / c_max : 0.0;
+    double s = cfg.weight_curvature * c + cfg.weight_rarity * f.rarity[i] +
+               cfg.weight_edge * (f.edge[i] == EdgeType::kOccluding ? 1.0 : 0.0);
+    if (f.edge[i] == EdgeType::kShadow) s = cfg.drop_shadow_points ? 0.0 : s * cfg.shadow_weight;
+    f.score[i] = std::isfinite(s) ? std::max(0.0, s) : 0.0;
+  }
+  return f;
+}
+
+std::vector<int> saliencyResample(const PreprocessedScan& scan, std::size_t budget, const SaliencyConfig& cfg,
+                                  std::uint64_t seed) {
+  const std::size_t n = scan.points.size();
+  const std::vector<Eigen::Vector2d>& p = scan.points;
+  if (n == 0 || budget == 0) return {};
+  const SaliencyFeatures f = computeSaliency(scan, cfg);
+
+  std::vector<char> eligible(n, 1);
+  std::size_t n_eligible = n;
+  if (cfg.drop_shadow_points) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (f.edge[i] == EdgeType::kShadow) eligible[i] = 0, --n_eligible;
+  }
+  std::vector<int> out;
+  if (budget >= n_eligible) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (eligible[i]) out.push_back(static_cast<int>(i));
+    return out;
+  }
+  out.reserve(budget);
+  std::vector<char> chosen(n, 0);
+
+  // Phase 1: about salient_fraction·budget points by score, no two closer than min_spacing (so one
+  // corner does not take several slots). Keys: the score itself, or Efraimidis–Spirakis keys
+  // log(u)/w for weighted sampling without replacement (one u per point, drawn in index order).
+  const double frac = std::clamp(std::isfinite(cfg.salient_fraction) ? cfg.salient_fraction : 0.0, 0.0, 1.0);
+  const std::size_t n_salient = std::min(budget, static_cast<std::size_t>(std::lround(frac * budget)));
+  std::vector<double> key(f.score);
+  if (cfg.weighted_sampling) {
+    std::mt19937_64 rng(seed);
+    for (std::size_t i = 0; i < n; ++i) {
+      // u in (0, 1] from the raw 64 bits: identical on every standard library, unlike the distributions.
+      const double u = (static_cast<double>(rng() >> 11) + 1.0) * 0x1.0p-53;
+      const double w = std::pow(f.score[i], cfg.sampling_exponent);
+      key[i] = (w > 0.0 && std::isfinite(w)) ? std::log(u) / w : -std::numeric_limits<double>::infinity();
+    }
+  }
+  // Candidates are local score maxima (over the PCA neighbourhood): the points around a corner share
+  // its high score, and without this the sampler often takes one of them and the spacing then blocks
+  // the corner itself.
+  const std::size_t k = static_cast<std::size_t>(std::max(1, cfg.neighbours));
+  const double r2 = cfg.neighbour_radius * cfg.neighbour_radius;
+  std::vector<int> order;
+  order.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!eligible[i] || !(f.score[i] > 0.0)) continue;
+    bool is_max = true;
+    const std::size_t j1 = std::min(n - 1, i + k);
+    for (std::size_t j = i >= k ? i - k : 0; j <= j1 && is_max; ++j)
+      is_max = !(f.segment[j] == f.segment[i] && f.score[j] > f.score[i] && (p[j] - p[i]).squaredNorm() <= r2);
+    if (is_max) order.push_back(static_cast<int>(i));
+  }
+  std::stable_sort(order.begin(), order.end(), [&key](int a, int b) { return key[a] > key[b]; });
+  const double sp2 = std::max(0.0, cfg.min_spacing) * std::max(0.0, cfg.min_spacing);
+  for (int i : order) {
+    if (out.size() >= n_salient) break;
+    bool far_enough = true;
+    for (int j : out) {
+      if ((p[i] - p[j]).squaredNorm() < sp2) {
+        far_enough = false;
+        break;
+      }
+    }
+    if (!far_enough) continue;
+    out.push_back(i);
+    chosen[i] = 1;
+  }
+
+  // Phase 2: coverage by farthest-point sampling from what is already chosen: spatially uniform, so the
+  // dense clusters near the laser do not take the budget (the thesis's URG-04LX problem).
+  // O(n) per pick over plain arrays (the scan's hot loop after the NDT score): points that may not be
+  // picked carry −inf, which min() keeps and the arg-max never takes.
+  std::vector<double> xs(n), ys(n), dist2(n, std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i] = p[i].x();
+    ys[i] = p[i].y();
+    if (!eligible[i] || chosen[i]) dist2[i] = -std::numeric_limits<double>::infinity();
+  }
+  // Adds point j to the picks; returns the farthest point from all picks (−1: none left).
+  auto pick = [&](std::size_t j) {
+    const double qx = xs[j], qy = ys[j];
+    int best = -1;
+    double best_d = -1.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double dx = xs[i] - qx, dy = ys[i] - qy;
+      const double d = std::min(dist2[i], dx * dx + dy * dy);
+      dist2[i] = d;
+      if (d > best_d) best_d = d, best = static_cast<int>(i);
+    }
+    return best;
+  };
+  int best = -1;
+  if (out.empty()) {
+    for (std::size_t i = 0; i < n && best < 0; ++i)
+      if (dist2[i] > 0.0) best = static_cast<int>(i);
+  }
+  for (int j : out) best = pick(static_cast<std::size_t>(j));
+  while (out.size() < budget && best >= 0) {
+    out.push_back(best);
+    chosen[best] = 1;
+    dist2[best] = -std::numeric_limits<double>::infinity();
+    best = pick(static_cast<std::size_t>(best));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace laser_dpslam

@@ -1,0 +1,757 @@
+#include "laser_dpslam/slam/dpslam_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace laser_dpslam {
+
+static_assert(sizeof(MapEntry) == 16, "MapEntry grew: the map's memory is mostly entries");
+
+namespace {
+void requireNodeId(int node) {
+  if (node < 0 || node > DpSlamMap::kMaxNodeId) {
+    throw std::out_of_range("DpSlamMap: node ID " + std::to_string(node) + " outside [0, " +
+                            std::to_string(DpSlamMap::kMaxNodeId) + "]");
+  }
+}
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Entry blocks: size classes of capacity 1, 2, 4, … entries, carved out of fixed-size chunks so that a
+// growing map never reallocates (and copies) what it already holds. Freed blocks go to a per-class free
+// list and are reused first.
+class DpSlamMap::EntryPool {
+ public:
+  static constexpr int kClasses = 20;
+  static constexpr int kChunkShift = 14;  ///< 16384 entries per chunk (or one block, if larger)
+
+  MapEntry* at(int cls, std::uint32_t block) const {
+    const int shift = blocksShift(cls);
+    return chunks_[cls][block >> shift].get() + (static_cast<std::size_t>(block & ((1u << shift) - 1)) << cls);
+  }
+  std::uint32_t allocate(int cls) {
+    if (cls >= kClasses) throw std::length_error("DpSlamMap: too many entries in one cell");
+    if (!free_[cls].empty()) {
+      const std::uint32_t b = free_[cls].back();
+      free_[cls].pop_back();
+      return b;
+    }
+    const std::uint32_t per_chunk = 1u << blocksShift(cls);
+    if (next_[cls] == chunks_[cls].size() * per_chunk) {
+      chunks_[cls].emplace_back(new MapEntry[static_cast<std::size_t>(per_chunk) << cls]);
+    }
+    return next_[cls]++;
+  }
+  void release(int cls, std::uint32_t block) { free_[cls].push_back(block); }
+  std::size_t bytes() const {
+    std::size_t b = 0;
+    for (int c = 0; c < kClasses; ++c) {
+      b += chunks_[c].size() * ((static_cast<std::size_t>(1) << blocksShift(c)) << c) * sizeof(MapEntry);
+      b += free_[c].capacity() * sizeof(std::uint32_t);
+    }
+    return b;
+  }
+
+ private:
+  static int blocksShift(int cls) { return cls >= kChunkShift ? 0 : kChunkShift - cls; }
+  std::vector<std::unique_ptr<MapEntry[]>> chunks_[kClasses];
+  std::vector<std::uint32_t> free_[kClasses];
+  std::uint32_t next_[kClasses] = {};
+};
+
+// ---------------------------------------------------------------------------------------------------
+void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_nodes) {
+  slot_nodes_ = slot_nodes;
+  parent_.assign(tree.idCapacity(), -1);
+  for (std::size_t i = 0; i < tree.idCapacity(); ++i) {
+    if (tree.valid(static_cast<int>(i))) parent_[i] = tree.parent(static_cast<int>(i));
+  }
+  root_ = tree.root();
+  if (memo_.size() < tree.idCapacity()) {
+    memo_.resize(tree.idCapacity(), -1);
+    memo_stamp_.resize(tree.idCapacity(), 0);
+  }
+  rows_.clear();
+  if (++stamp_ == 0) {  // wrapped: forget every stamp
+    for (auto& t : tiles_) {
+      if (t) std::memset(t->cells, 0, sizeof(t->cells));
+    }
+    stamp_ = 1;
+  }
+}
+
+std::size_t LookupCache::memoryBytes() const {
+  std::size_t b = rows_.capacity() * sizeof(std::int32_t) + tiles_.capacity() * sizeof(void*);
+  for (const auto& t : tiles_) {
+    if (t) b += sizeof(TileRows);
+  }
+  return b + (memo_.capacity() + memo_stamp_.capacity()) * 4 + (slot_nodes_.capacity() + parent_.capacity()) * sizeof(int);
+}
+
+// ---------------------------------------------------------------------------------------------------
+DpSlamMap::DpSlamMap(double resolution, double entry_prior_cells)
+    : resolution_(resolution), prior_distance_(entry_prior_cells * resolution), pool_(new EntryPool) {
+  if (!(resolution > 0.0)) throw std::invalid_argument("DpSlamMap: resolution must be > 0");
+  if (!(entry_prior_cells > 0.0)) throw std::invalid_argument("DpSlamMap: entry_prior_cells must be > 0");
+}
+
+DpSlamMap::~DpSlamMap() = default;
+
+void DpSlamMap::clear() {
+  tiles_.clear();
+  directory_.clear();
+  tx0_ = ty0_ = ntx_ = nty_ = 0;
+  pool_.reset(new EntryPool);
+  owned_.clear();
+  entries_ = 0;
+  observed_cells_ = 0;
+}
+
+int DpSlamMap::tileId(int ix, int iy) const {
+  const int tx = (ix >> kTileShift) - tx0_, ty = (iy >> kTileShift) - ty0_;
+  if (tx < 0 || ty < 0 || tx >= ntx_ || ty >= nty_) return -1;
+  return directory_[static_cast<std::size_t>(ty) * ntx_ + tx];
+}
+
+int DpSlamMap::ensureTile(int ix, int iy) {
+  const int id = tileId(ix, iy);
+  if (id >= 0) return id;
+  const int tx = ix >> kTileShift, ty = iy >> kTileShift;
+  if (tx < tx0_ || ty < ty0_ || tx >= tx0_ + ntx_ || ty >= ty0_ + nty_) {
+    // Grow the directory with a margin, so that it is rebuilt rarely.
+    constexpr int kMargin = 8;
+    int nx0 = tx0_, ny0 = ty0_, nx1 = tx0_ + ntx_, ny1 = ty0_ + nty_;
+    if (ntx_ == 0) {
+      nx0 = tx - kMargin;
+      ny0 = ty - kMargin;
+      nx1 = tx + kMargin + 1;
+      ny1 = ty + kMargin + 1;
+    } else {
+      if (tx < nx0) nx0 = tx - kMargin;
+      if (ty < ny0) ny0 = ty - kMargin;
+      if (tx >= nx1) nx1 = tx + kMargin + 1;
+      if (ty >= ny1) ny1 = ty + kMargin + 1;
+    }
+    std::vector<std::int32_t> dir(static_cast<std::size_t>(nx1 - nx0) * (ny1 - ny0), -1);
+    for (int y = 0; y < nty_; ++y) {
+      for (int x = 0; x < ntx_; ++x) {
+        dir[static_cast<std::size_t>(y + ty0_ - ny0) * (nx1 - nx0) + (x + tx0_ - nx0)] =
+            directory_[static_cast<std::size_t>(y) * ntx_ + x];
+      }
+    }
+    directory_.swap(dir);
+    tx0_ = nx0;
+    ty0_ = ny0;
+    ntx_ = nx1 - nx0;
+    nty_ = ny1 - ny0;
+  }
+  const int nid = static_cast<int>(tiles_.size());
+  tiles_.emplace_back(new Tile);
+  tiles_.back()->tx = tx;
+  tiles_.back()->ty = ty;
+  directory_[static_cast<std::size_t>(ty - ty0_) * ntx_ + (tx - tx0_)] = nid;
+  return nid;
+}
+
+MapEntry* DpSlamMap::entriesOf(const Cell& c) const { return c.size ? c.entries : nullptr; }
+
+void DpSlamMap::setBlock(Cell& c, int cls, std::uint32_t block) {
+  c.cls = static_cast<std::uint8_t>(cls);
+  c.block = block;
+  c.entries = pool_->at(cls, block);
+}
+
+const MapEntry* DpSlamMap::cellEntries(int ix, int iy, int* n) const {
+  const int t = tileId(ix, iy);
+  if (t < 0) {
+    *n = 0;
+    return nullptr;
+  }
+  const Cell& c = tiles_[t]->cells[cellInTile(ix, iy)];
+  *n = c.size;
+  return entriesOf(c);
+}
+
+std::size_t DpSlamMap::memoryBytes() const {
+  std::size_t b = tiles_.size() * sizeof(Tile) + tiles_.capacity() * sizeof(void*) +
+                  directory_.capacity() * sizeof(std::int32_t) + pool_->bytes();
+  for (const auto& l : owned_) b += sizeof(l) + l.capacity() * sizeof(EntryRef);
+  return b;
+}
+
+bool DpSlamMap::bounds(int* x0, int* y0, int* x1, int* y1) const {
+  if (tiles_.empty()) return false;
+  int a = tiles_[0]->tx, b = tiles_[0]->ty, c = a, d = b;
+  for (const auto& t : tiles_) {
+    a = std::min(a, t->tx);
+    b = std::min(b, t->ty);
+    c = std::max(c, t->tx);
+    d = std::max(d, t->ty);
+  }
+  *x0 = a * kTileSize;
+  *y0 = b * kTileSize;
+  *x1 = (c + 1) * kTileSize - 1;
+  *y1 = (d + 1) * kTileSize - 1;
+  return true;
+}
+
+// --- Entries ---------------------------------------------------------------------------------------
+int DpSlamMap::appendEntry(int tile, int cell, const MapEntry& e) {
+  Cell& c = tiles_[tile]->cells[cell];
+  if (c.size == 0) {
+    if (c.cls == 0xFF) setBlock(c, 0, pool_->allocate(0));
+    ++observed_cells_;
+  } else if (c.size == (1u << c.cls)) {
+    const int ncls = c.cls + 1;
+    const std::uint32_t nb = pool_->allocate(ncls);
+    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
+    pool_->release(c.cls, c.block);
+    setBlock(c, ncls, nb);
+  }
+  if (c.size == 0xFFFF) throw std::length_error("DpSlamMap: too many entries in one cell");
+  c.entries[c.size] = e;
+  ++entries_;
+  return c.size++;
+}
+
+void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
+  Cell& c = tiles_[tile]->cells[cell];
+  MapEntry* e = c.entries;
+  const int last = c.size - 1;
+  if (slot != last) {
+    e[slot] = e[last];
+    owned_[e[slot].owner][e[slot].back].slot = static_cast<std::uint16_t>(slot);
+  }
+  --c.size;
+  --entries_;
+  if (c.size == 0) {
+    pool_->release(c.cls, c.block);
+    c.cls = 0xFF;
+    c.block = 0;
+    c.entries = nullptr;
+    --observed_cells_;
+  } else if (c.cls > 0 && c.size <= ((1u << c.cls) >> 2)) {
+    const int ncls = c.cls - 1;
+    const std::uint32_t nb = pool_->allocate(ncls);
+    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
+    pool_->release(c.cls, c.block);
+    setBlock(c, ncls, nb);
+  }
+}
+
+void DpSlamMap::removeFromOwner(int owner, std::uint32_t back) {
+  auto& list = owned_[owner];
+  const std::size_t last = list.size() - 1;
+  if (back != last) {
+    list[back] = list[last];
+    const EntryRef& r = list[back];
+    tiles_[r.tile]->cells[r.cell].entries[r.slot].back = back;
+  }
+  list.pop_back();
+}
+
+void DpSlamMap::deleteNode(int id) {
+  if (id < 0 || id >= static_cast<int>(owned_.size())) return;
+  auto& list = owned_[id];
+  for (const EntryRef& r : list) removeFromCell(r.tile, r.cell, r.slot);
+  std::vector<EntryRef>().swap(list);  // free the storage
+}
+
+void DpSlamMap::mergeChildIntoParent(int child, int parent) {
+  requireNodeId(parent);
+  const int need = std::max(child, parent) + 1;
+  if (static_cast<int>(owned_.size()) < need) owned_.resize(need);
+  auto& cl = owned_[child];
+  auto& pl = owned_[parent];
+  constexpr std::uint16_t kDead = 0xFFFF;
+  for (std::size_t i = 0; i < cl.size(); ++i) {
+    const int tile = cl[i].tile, cell = cl[i].cell;
+    Cell& c = tiles_[tile]->cells[cell];
+    MapEntry* e = c.entries;
+    int dup = -1;
+    for (int j = 0; j < c.size; ++j) {
+      if (e[j].owner == parent) {
+        dup = j;
+        break;
+      }
+    }
+    if (dup >= 0) {
+      if (e[dup].distance > e[cl[i].slot].distance) {
+        // The parent's entry has seen more: it is the newer one; the child's goes.
+        removeFromCell(tile, cell, cl[i].slot);
+        cl[i].slot = kDead;
+        continue;
+      }
+      removeFromOwner(parent, e[dup].back);
+      removeFromCell(tile, cell, dup);  // may move the child's entry: cl[i].slot follows
+    }
+    MapEntry& me = c.entries[cl[i].slot];
+    me.owner = static_cast<std::int16_t>(parent);
+    me.back = static_cast<std::uint32_t>(pl.size());
+    pl.push_back(cl[i]);
+  }
+  std::vector<EntryRef>().swap(cl);
+}
+
+// --- Lookups ---------------------------------------------------------------------------------------
+const MapEntry* DpSlamMap::lookup(int ix, int iy, int node, const AncestryTree& tree) const {
+  int n = 0;
+  const MapEntry* e = cellEntries(ix, iy, &n);
+  if (n == 0) return nullptr;
+  for (int a = node; a >= 0; a = tree.parent(a)) {
+    for (int j = 0; j < n; ++j) {
+      if (e[j].owner == a) return &e[j];
+    }
+  }
+  return nullptr;
+}
+
+std::vector<int> DpSlamMap::lineageRank(const AncestryTree& tree, int node) {
+  std::vector<int> rank(tree.idCapacity(), -1);
+  int r = 0;
+  for (int a = node; a >= 0; a = tree.parent(a)) rank[a] = r++;
+  return rank;
+}
+
+const MapEntry* DpSlamMap::lookup(int ix, int iy, const std::vector<int>& rank) const {
+  int n = 0;
+  const MapEntry* e = cellEntries(ix, iy, &n);
+  const MapEntry* best = nullptr;
+  int best_rank = 0;
+  for (int j = 0; j < n; ++j) {
+    const int o = e[j].owner;
+    const int r = o < static_cast<int>(rank.size()) ? rank[o] : -1;
+    if (r >= 0 && (!best || r < best_rank)) {
+      best = &e[j];
+      best_rank = r;
+    }
+  }
+  return best;
+}
+
+namespace {
+/// Unit vectors of the 255 quantised normal angles (index 0 unused).
+struct NormalTable {
+  double c[256], s[256];
+  NormalTable() {
+    c[0] = s[0] = 0.0;
+    for (int k = 1; k < 256; ++k) {
+      const double a = (k - 0.5) * M_PI / 255.0;
+      c[k] = std::cos(a);
+      s[k] = std::sin(a);
+    }
+  }
+};
+const NormalTable& normalTable() {
+  static const NormalTable t;
+  return t;
+}
+
+constexpr std::uint32_t kUniform = 0x80000000u;  ///< row word flag: every slot sees entry (word & ~flag) − 1
+}  // namespace
+
+void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
+  const Cell& c = tiles_[tile]->cells[cell];
+  const MapEntry* e = entriesOf(c);
+  const std::size_t slots = cache.slot_nodes_.size();
+  cache.scratch_.resize(slots);
+  std::int32_t* out = cache.scratch_.data();
+  if (++cache.memo_counter_ == 0) {  // wrapped
+    std::fill(cache.memo_stamp_.begin(), cache.memo_stamp_.end(), 0u);
+    cache.memo_counter_ = 1;
+  }
+  const std::uint32_t mark = cache.memo_counter_;
+  for (int j = 0; j < c.size; ++j) {
+    const int o = e[j].owner;
+    if (o < static_cast<int>(cache.memo_.size())) {
+      cache.memo_[o] = j;
+      cache.memo_stamp_[o] = mark;
+    }
+  }
+  int stack[64];
+  std::vector<int> big_stack;
+  bool uniform = true;
+  for (std::size_t s = 0; s < slots; ++s) {
+    int n = cache.slot_nodes_[s];
+    int depth = 0;
+    big_stack.clear();
+    while (n >= 0 && cache.memo_stamp_[n] != mark) {
+      if (depth < 64) {
+        stack[depth] = n;
+      } else {
+        big_stack.push_back(n);
+      }
+      ++depth;
+      n = cache.parent_[n];
+    }
+    const int value = n < 0 ? -1 : cache.memo_[n];
+    for (int k = 0; k < depth; ++k) {
+      const int x = k < 64 ? stack[k] : big_stack[k - 64];
+      cache.memo_[x] = value;
+      cache.memo_stamp_[x] = mark;
+    }
+    out[s] = cache.memo_[cache.slot_nodes_[s]];
+    uniform = uniform && out[s] == out[0];
+  }
+  LookupCache::TileRows& tr = *cache.tiles_[tile];
+  tr.cells[cell].stamp = cache.stamp_;
+  if (uniform && slots > 0) {
+    tr.cells[cell].row = kUniform | static_cast<std::uint32_t>(out[0] + 1);
+  } else {
+    tr.cells[cell].row = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
+    cache.rows_.insert(cache.rows_.end(), out, out + slots);
+  }
+}
+
+void DpSlamMap::setRowSlot(LookupCache& cache, int tile, int cell, int slot, int value) {
+  if (static_cast<std::size_t>(tile) >= cache.tiles_.size() || !cache.tiles_[tile]) return;
+  LookupCache::TileRows& tr = *cache.tiles_[tile];
+  if (tr.cells[cell].stamp != cache.stamp_) return;  // no row yet: it will be built from the map
+  const std::size_t slots = cache.slot_nodes_.size();
+  std::uint32_t word = tr.cells[cell].row;
+  if (word & kUniform) {  // materialise the row
+    const std::int32_t v = static_cast<std::int32_t>(word & ~kUniform) - 1;
+    word = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
+    cache.rows_.insert(cache.rows_.end(), slots, v);
+    tr.cells[cell].row = word;
+  }
+  cache.rows_[static_cast<std::size_t>(word) * slots + slot] = value;
+}
+
+inline bool DpSlamMap::seek(Cursor& cur, int ix, int iy, LookupCache& cache) const {
+  const int tx = ix >> kTileShift, ty = iy >> kTileShift;
+  if (tx == cur.tx && ty == cur.ty) return cur.tile >= 0;
+  cur.tx = tx;
+  cur.ty = ty;
+  cur.tile = tileId(ix, iy);
+  if (cur.tile < 0) return false;
+  cur.t = tiles_[cur.tile].get();
+  if (static_cast<std::size_t>(cur.tile) >= cache.tiles_.size()) cache.tiles_.resize(tiles_.size());
+  auto& tr = cache.tiles_[cur.tile];
+  if (!tr) tr.reset(new LookupCache::TileRows());
+  cur.rows = tr.get();
+  return true;
+}
+
+inline bool DpSlamMap::seek(Cursor& cur, int ix, int iy, LookupCache& cache, bool create) {
+  const int tx = ix >> kTileShift, ty = iy >> kTileShift;
+  if (tx == cur.tx && ty == cur.ty && cur.tile >= 0) return true;
+  if (create) {
+    ensureTile(ix, iy);
+    cur.tx = std::numeric_limits<int>::min();
+  }
+  return static_cast<const DpSlamMap*>(this)->seek(cur, ix, iy, cache);
+}
+
+inline MapEntry* DpSlamMap::resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const {
+  const Cell& c = cur.t->cells[cell];
+  if (c.size == 0) return nullptr;
+  MapEntry* e = c.entries;
+  if (c.size == 1 && e->owner == cache.root_) return e;  // seen by everyone
+  const auto& rc = static_cast<const LookupCache::TileRows*>(cur.rows)->cells[cell];
+  if (rc.stamp != cache.stamp_) buildRow(cur.tile, cell, cache);
+  const std::uint32_t word = rc.row;
+  const int j = (word & kUniform) ? static_cast<int>(word & ~kUniform) - 1
+                                  : cache.rows_[static_cast<std::size_t>(word) * cache.slot_nodes_.size() + slot];
+  return j < 0 ? nullptr : e + j;
+}
+
+const MapEntry* DpSlamMap::visibleCached(int tile, int cell, int slot, LookupCache& cache) const {
+  Cursor cur;
+  const Tile& t = *tiles_[tile];
+  if (!seek(cur, t.tx << kTileShift, t.ty << kTileShift, cache)) return nullptr;
+  return resolve(cur, cell, slot, cache);
+}
+
+const MapEntry* DpSlamMap::cachedLookup(int ix, int iy, int slot, LookupCache& cache) const {
+  const int t = tileId(ix, iy);
+  if (t < 0) return nullptr;
+  return visibleCached(t, cellInTile(ix, iy), slot, cache);
+}
+
+int DpSlamMap::quantizeNormal(double nx, double ny) {
+  if (nx == 0.0 && ny == 0.0) return 0;
+  double a = std::atan2(ny, nx);  // a normal's sign does not matter: angle modulo π
+  if (a < 0.0) a += M_PI;
+  if (a >= M_PI) a -= M_PI;
+  return std::min(255, 1 + static_cast<int>(a * (255.0 / M_PI)));
+}
+
+int DpSlamMap::quantizeOffset(double s) const {
+  const double k = std::round(s * (127.0 / (0.75 * resolution_))) + 128.0;
+  return static_cast<int>(std::min(255.0, std::max(1.0, k)));
+}
+
+inline double DpSlamMap::stopPoint(int ix, int iy, int q, int k, const MapBeam& b, double t0, double t1) const {
+  if (q && k) {
+    const NormalTable& n = normalTable();
+    const double cd = n.c[q] * b.dx + n.s[q] * b.dy;
+    if (std::abs(cd) > 1e-6) {
+      // n·(o + t·dir − centre) = offset
+      const double cx = (ix + 0.5) * resolution_ - b.ox, cy = (iy + 0.5) * resolution_ - b.oy;
+      const double t = (offsetValue(k) + n.c[q] * cx + n.s[q] * cy) / cd;
+      return std::min(t1, std::max(t0, t));
+    }
+  }
+  return 0.5 * (t0 + t1);
+}
+
+std::uint8_t DpSlamMap::meanOffset(int old_q, int old_k, double old_hits, int new_q, int hit_offset) const {
+  if (!new_q || !hit_offset) return static_cast<std::uint8_t>(old_k);
+  if (!(old_hits > 0.0)) return static_cast<std::uint8_t>(hit_offset);
+  double s_old = 0.0;
+  if (old_q && old_k) {
+    // The old surface line's point nearest the centre, measured along the new normal.
+    const NormalTable& n = normalTable();
+    s_old = offsetValue(old_k) * (n.c[old_q] * n.c[new_q] + n.s[old_q] * n.s[new_q]);
+  }
+  const double s = s_old + (offsetValue(hit_offset) - s_old) / (old_hits + 1.0);
+  return static_cast<std::uint8_t>(quantizeOffset(s));
+}
+
+inline double DpSlamMap::chordFactor(int q, const MapBeam& b, bool near_return) const {
+  if (q) {
+    const NormalTable& n = normalTable();
+    return std::max(cell_normal_min_cos_, std::abs(n.c[q] * b.dx + n.s[q] * b.dy));
+  }
+  return near_return ? b.incidence : 1.0;
+}
+
+// --- Updates ---------------------------------------------------------------------------------------
+namespace {
+struct Observation {
+  float d;
+  float hit;
+};
+}  // namespace
+
+void DpSlamMap::observe(int ix, int iy, int node, const AncestryTree& tree, double d, bool hit) {
+  requireNodeId(node);
+  const int tile = ensureTile(ix, iy);
+  const int cell = cellInTile(ix, iy);
+  const MapEntry* vis = lookup(ix, iy, node, tree);
+  if (static_cast<int>(owned_.size()) <= node) owned_.resize(node + 1);
+  if (vis && vis->owner == node) {
+    MapEntry* m = const_cast<MapEntry*>(vis);
+    m->hits += hit ? 1.0f : 0.0f;
+    m->distance += static_cast<float>(d);
+    return;
+  }
+  MapEntry ne;
+  ne.owner = static_cast<std::int16_t>(node);
+  ne.hits = (vis ? vis->hits : 0.0f) + (hit ? 1.0f : 0.0f);
+  ne.distance = vis ? vis->distance + static_cast<float>(d) : static_cast<float>(d + prior_distance_);
+  ne.back = static_cast<std::uint32_t>(owned_[node].size());
+  const int s = appendEntry(tile, cell, ne);
+  owned_[node].push_back({static_cast<std::uint32_t>(tile), static_cast<std::uint16_t>(cell), static_cast<std::uint16_t>(s)});
+}
+
+void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCache& cache, double free_saturation,
+                         std::vector<CellWrite>& out, bool only_unknown) const {
+  const float saturation = free_saturation > 0.0 ? static_cast<float>(free_saturation) : std::numeric_limits<float>::infinity();
+  const bool hit = !b.no_return && b.range <= max_range;
+  const double length = std::min(b.range, max_range);
+  // Near the surface hit, distance counts along its normal (setSurfaceDepth).
+  const double surface_from = hit && surface_depth_ > 0.0 ? length - surface_depth_ : length + 1.0;
+  // setCellNormals: the cell the beam stops in takes the normal of the surface it hit.
+  const bool normals = cell_normal_min_cos_ > 0.0;
+  const int beam_normal = normals && hit ? quantizeNormal(b.nx, b.ny) : 0;
+  Cursor cur;
+  traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, length, resolution_, [&](int ix, int iy, double t0, double t1) {
+    const bool end = hit && t1 >= length;
+    int q = 0;  // the cell's normal, if it has statistics
+    if ((normals || !end || only_unknown) && seek(cur, ix, iy, cache)) {
+      const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache);
+      if (v && only_unknown) return true;
+      if (v) {
+        if (!end && v->hits == 0.0f && v->distance >= saturation) return true;
+        if (normals) q = v->normal;
+      }
+    }
+    if (end && !q) q = beam_normal;  // a new surface cell: the normal it is about to take
+    // Filled in place: a CellWrite built on the stack and copied in stalls on store forwarding.
+    out.emplace_back();
+    CellWrite& w = out.back();
+    w.ix = ix;
+    w.iy = iy;
+    w.d = static_cast<float>((t1 - t0) * chordFactor(q, b, t1 >= surface_from));
+    w.hit = end ? 1.0f : 0.0f;
+    if (end) {
+      w.normal = static_cast<std::uint8_t>(beam_normal);
+      const int nq = beam_normal ? beam_normal : q;  // the normal the entry has after this write
+      if (surface_offsets_ && nq) {
+        const NormalTable& n = normalTable();
+        const double px = b.ox + b.dx * length - (ix + 0.5) * resolution_;
+        const double py = b.oy + b.dy * length - (iy + 0.5) * resolution_;
+        w.offset = static_cast<std::uint8_t>(quantizeOffset(n.c[nq] * px + n.s[nq] * py));
+      }
+    }
+    return true;
+  });
+}
+
+void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache,
+                            double free_saturation) {
+  const float saturation = free_saturation > 0.0 ? static_cast<float>(free_saturation) : std::numeric_limits<float>::infinity();
+  requireNodeId(node);
+  if (static_cast<int>(owned_.size()) <= node) owned_.resize(node + 1);
+  Cursor cur;
+  for (const CellWrite& w : writes) {
+    seek(cur, w.ix, w.iy, cache, true);
+    const int cell = cellInTile(w.ix, w.iy);
+    MapEntry* vis = resolve(cur, cell, slot, cache);
+    MapEntry ne;
+    ne.owner = static_cast<std::int16_t>(node);
+    ne.normal = w.normal;
+    ne.offset = w.offset;
+    if (vis) {
+      MapEntry& v = *vis;
+      if (w.hit == 0.0f && v.hits == 0.0f && v.distance >= saturation) continue;
+      const int nq = w.normal ? w.normal : v.normal;
+      const std::uint8_t offset = w.offset ? meanOffset(v.normal, v.offset, v.hits, nq, w.offset) : v.offset;
+      if (v.owner == node) {
+        v.hits += w.hit;
+        v.distance += w.d;
+        if (w.normal) v.normal = w.normal;
+        v.offset = offset;
+        continue;
+      }
+      ne.hits = v.hits + w.hit;
+      ne.distance = v.distance + w.d;
+      if (!w.normal) ne.normal = v.normal;  // the copy keeps what the lineage saw
+      ne.offset = offset;
+    } else {
+      ne.hits = w.hit;
+      ne.distance = w.d + static_cast<float>(prior_distance_);
+    }
+    ne.back = static_cast<std::uint32_t>(owned_[node].size());
+    const int s = appendEntry(cur.tile, cell, ne);
+    owned_[node].push_back({static_cast<std::uint32_t>(cur.tile), static_cast<std::uint16_t>(cell), static_cast<std::uint16_t>(s)});
+    // Keep this slot's cached view in step (other slots cannot see the new entry: it is a leaf's).
+    setRowSlot(cache, cur.tile, cell, slot, s);
+  }
+}
+
+void DpSlamMap::addBeam(const MapBeam& b, double max_range, int slot, int node, LookupCache& cache,
+                        double free_saturation) {
+  std::vector<CellWrite> writes;
+  planBeam(b, max_range, slot, cache, free_saturation, writes);
+  applyWrites(writes, slot, node, cache, free_saturation);
+}
+
+// --- Observation model -----------------------------------------------------------------------------
+double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot, LookupCache& cache,
+                                    const BeamModelConfig& m) const {
+  const bool no_return = b.no_return || b.range >= max_range;
+  const double z = std::min(b.range, max_range);
+  const double t_end = no_return ? z : std::min(z + m.window, max_range);
+  const double window_start = z - m.window;
+  const double inv_2s2 = 0.5 / (m.sigma * m.sigma);
+  const double mu_unknown = 1.0 / m.unknown_mean_free_path;
+  const double surface = no_return ? 0.0 : surface_depth_;  // setSurfaceDepth: |t - z| < this counts along the normal
+  const bool normals = cell_normal_min_cos_ > 0.0;
+  const bool offsets = normals && surface_offsets_;
+  double tau = 0.0, reach = 1.0, eval = 0.0;
+  bool in_window = false;
+  Cursor cur;
+  traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, t_end, resolution_, [&](int ix, int iy, double t0, double t1) {
+    double mu = mu_unknown;
+    int q = 0, k = 0;
+    if (seek(cur, ix, iy, cache)) {
+      if (const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache)) {
+        mu = v->density();
+        if (normals) q = v->normal;
+        if (offsets) k = v->offset;
+      }
+    }
+    if (mu == 0.0) return true;
+    double d = (t1 - t0) * chordFactor(q, b, std::abs(0.5 * (t0 + t1) - z) < surface);
+    if (t1 < window_start) {
+      tau += mu * d;
+      return true;
+    }
+    if (!in_window) {
+      reach = std::exp(-tau);
+      in_window = true;
+    }
+    const double pass = std::exp(-mu * d);
+    const double stop = reach * (1.0 - pass);
+    reach *= pass;
+    const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
+    if (std::abs(e) < m.window) eval += stop * std::exp(-e * e * inv_2s2);
+    return reach > 1e-9;  // nothing left to explain: stop tracing
+  });
+  if (!in_window) reach = std::exp(-tau);
+  const double value = no_return ? eval + reach : (reach < 1.0 ? eval / (1.0 - reach) : 0.0);
+  return value > 0.0 ? std::max(std::log(value), m.log_floor) : m.log_floor;
+}
+
+double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window, int slot, LookupCache& cache,
+                                            const BeamModelConfig& m) const {
+  if (b.no_return) return 0.0;
+  const double z = b.range;
+  const double inv_2s2 = 0.5 / (m.sigma * m.sigma);
+  const double mu_unknown = 1.0 / m.unknown_mean_free_path;
+  double reach = 1.0, eval = 0.0;
+  Cursor cur;
+  traceCells(b.ox, b.oy, b.dx, b.dy, std::max(0.0, z - half_window), z + half_window, resolution_,
+             [&](int ix, int iy, double t0, double t1) {
+               double mu = mu_unknown;
+               int q = 0, k = 0;
+               if (seek(cur, ix, iy, cache)) {
+                 if (const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache)) {
+                   mu = v->density();
+                   if (cell_normal_min_cos_ > 0.0) {
+                     q = v->normal;
+                     if (surface_offsets_) k = v->offset;
+                   }
+                 }
+               }
+               if (mu == 0.0) return true;
+               const double d = (t1 - t0) * chordFactor(q, b, std::abs(0.5 * (t0 + t1) - z) < surface_depth_);
+               const double pass = std::exp(-mu * d);
+               const double stop = reach * (1.0 - pass);
+               reach *= pass;
+               const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
+               eval += stop * std::exp(-e * e * inv_2s2);
+               return reach > 1e-9;
+             });
+  const double value = reach < 1.0 ? eval / (1.0 - reach) : 0.0;
+  return value > 0.0 ? std::max(std::log(value), m.log_floor) : m.log_floor;
+}
+
+// --- Consistency -----------------------------------------------------------------------------------
+std::string DpSlamMap::check() const {
+  std::size_t count = 0, cells = 0;
+  for (std::size_t t = 0; t < tiles_.size(); ++t) {
+    for (int ci = 0; ci < kTileSize * kTileSize; ++ci) {
+      const Cell& c = tiles_[t]->cells[ci];
+      if (c.size == 0) continue;
+      ++cells;
+      const MapEntry* e = entriesOf(c);
+      for (int j = 0; j < c.size; ++j) {
+        ++count;
+        const int o = e[j].owner;
+        if (o < 0 || o >= static_cast<int>(owned_.size()) || e[j].back >= owned_[o].size()) {
+          return "entry with a bad owner/back-index in tile " + std::to_string(t);
+        }
+        const EntryRef& r = owned_[o][e[j].back];
+        if (r.tile != t || r.cell != ci || r.slot != j) return "back-reference mismatch for owner " + std::to_string(o);
+        for (int k = j + 1; k < c.size; ++k) {
+          if (e[k].owner == o) return "two entries of owner " + std::to_string(o) + " in one cell";
+        }
+      }
+    }
+  }
+  std::size_t listed = 0;
+  for (const auto& l : owned_) listed += l.size();
+  if (count != entries_) return "entry counter mismatch";
+  if (cells != observed_cells_) return "observed cell counter mismatch";
+  if (listed != entries_) return "owner lists hold " + std::to_string(listed) + " refs for " + std::to_string(count) + " entries";
+  return std::string();
+}
+
+}  // namespace laser_dpslam
