@@ -64,7 +64,7 @@ class DemoRunTest(unittest.TestCase):
         out = tempfile.mkdtemp()
         log = os.path.join(out, "slam.csv")
         # The raw best path (trajectory_smoothing 0): its last pose is the filter's own (the smoothed path's
-        # is the mean of the last seconds' corrections, ~1 mm away; test/trajectory_smoother_test.cpp).
+        # is the mean of the last seconds' corrections, ~1 mm away; test/slam/trajectory_smoother_test.cpp).
         config = os.path.join(out, "raw.yaml")
         with open(config, "w") as f:
             f.write("trajectory_smoothing: 0\n")
