@@ -122,9 +122,7 @@ double yamlDouble(const YAML::Node& root, const std::string& key, const std::str
   }
 }
 
-}  // namespace
-
-FloorPlan FloorPlan::load(const std::string& yaml_path) {
+YAML::Node loadYaml(const std::string& yaml_path) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(yaml_path);
@@ -134,7 +132,10 @@ FloorPlan FloorPlan::load(const std::string& yaml_path) {
     fail(yaml_path, std::string("malformed YAML: ") + e.what());
   }
   if (!root.IsMap()) fail(yaml_path, "malformed floor-plan YAML: expected a map_server mapping (image, resolution, origin, ...)");
+  return root;
+}
 
+std::string imageName(const YAML::Node& root, const std::string& yaml_path) {
   const YAML::Node image_node = root["image"];
   if (!image_node) fail(yaml_path, "missing key 'image'");
   std::string image;
@@ -144,10 +145,11 @@ FloorPlan FloorPlan::load(const std::string& yaml_path) {
     fail(yaml_path, "key 'image' is not a string");
   }
   if (image.empty()) fail(yaml_path, "key 'image' is empty");
+  return image;
+}
 
-  const double resolution = yamlDouble(root, "resolution", yaml_path);
-  if (!(resolution > 0.0) || !std::isfinite(resolution)) fail(yaml_path, "resolution must be positive");
-
+/// The origin's x and y (its yaw must be 0).
+Eigen::Vector2d originOf(const YAML::Node& root, const std::string& yaml_path) {
   const YAML::Node origin_node = root["origin"];
   if (!origin_node) fail(yaml_path, "missing key 'origin'");
   if (!origin_node.IsSequence() || origin_node.size() != 3) fail(yaml_path, "origin must be [x, y, yaw]");
@@ -163,7 +165,10 @@ FloorPlan FloorPlan::load(const std::string& yaml_path) {
   if (std::abs(origin[2]) > 1e-9) {
     fail(yaml_path, "origin yaw " + std::to_string(origin[2]) + " is not supported (only 0)");
   }
+  return Eigen::Vector2d(origin[0], origin[1]);
+}
 
+bool negateOf(const YAML::Node& root, const std::string& yaml_path) {
   bool negate = false;
   if (const YAML::Node n = root["negate"]) {
     try {
@@ -176,10 +181,16 @@ FloorPlan FloorPlan::load(const std::string& yaml_path) {
       }
     }
   }
-  const double occupied_thresh = root["occupied_thresh"] ? yamlDouble(root, "occupied_thresh", yaml_path) : 0.65;
-  const double free_thresh = root["free_thresh"] ? yamlDouble(root, "free_thresh", yaml_path) : 0.196;
-  if (!(occupied_thresh >= 0.0 && occupied_thresh <= 1.0) || !(free_thresh >= 0.0 && free_thresh <= 1.0) ||
-      free_thresh > occupied_thresh) {
+  return negate;
+}
+
+/// occupied_thresh and free_thresh (map_server's defaults when absent); checks the mode too.
+void readThresholds(const YAML::Node& root, const std::string& yaml_path, double* occupied_thresh,
+                    double* free_thresh) {
+  *occupied_thresh = root["occupied_thresh"] ? yamlDouble(root, "occupied_thresh", yaml_path) : 0.65;
+  *free_thresh = root["free_thresh"] ? yamlDouble(root, "free_thresh", yaml_path) : 0.196;
+  if (!(*occupied_thresh >= 0.0 && *occupied_thresh <= 1.0) || !(*free_thresh >= 0.0 && *free_thresh <= 1.0) ||
+      *free_thresh > *occupied_thresh) {
     fail(yaml_path, "need 0 <= free_thresh <= occupied_thresh <= 1");
   }
   if (const YAML::Node m = root["mode"]) {
@@ -191,7 +202,10 @@ FloorPlan FloorPlan::load(const std::string& yaml_path) {
     }
     if (mode != "trinary" && mode != "scale") fail(yaml_path, "mode '" + mode + "' is not supported (trinary or scale)");
   }
+}
 
+/// The image's path (relative to the YAML's folder unless absolute); it must be a .pgm.
+std::string imageFile(const std::string& image, const std::string& yaml_path) {
   fs::path image_path(image);
   if (image_path.is_relative()) image_path = fs::path(yaml_path).parent_path() / image_path;
   const std::string image_file = image_path.string();
@@ -201,13 +215,27 @@ FloorPlan FloorPlan::load(const std::string& yaml_path) {
   if (ext_lower != ".pgm") {
     fail(yaml_path, "image '" + image + "' is not a .pgm file (only PGM images are supported)");
   }
-  const GreyImage img = readPgm(image_file);
+  return image_file;
+}
+
+}  // namespace
+
+FloorPlan FloorPlan::load(const std::string& yaml_path) {
+  const YAML::Node root = loadYaml(yaml_path);
+  const std::string image = imageName(root, yaml_path);
+  const double resolution = yamlDouble(root, "resolution", yaml_path);
+  if (!(resolution > 0.0) || !std::isfinite(resolution)) fail(yaml_path, "resolution must be positive");
+  const Eigen::Vector2d origin = originOf(root, yaml_path);
+  const bool negate = negateOf(root, yaml_path);
+  double occupied_thresh, free_thresh;
+  readThresholds(root, yaml_path, &occupied_thresh, &free_thresh);
+  const GreyImage img = readPgm(imageFile(image, yaml_path));
 
   FloorPlan plan;
   plan.width_ = img.width;
   plan.height_ = img.height;
   plan.resolution_ = resolution;
-  plan.origin_ = Eigen::Vector2d(origin[0], origin[1]);
+  plan.origin_ = origin;
   plan.source_ = yaml_path;
   plan.cells_.assign(static_cast<std::size_t>(img.width) * img.height, kUnknown);
   for (int row = 0; row < img.height; ++row) {

@@ -88,6 +88,44 @@ LoopError loopError(const DpSlam& slam) {
   return e;
 }
 
+// The map's walls are the floor plan's: occupied cells lie on the plan's walls, and the walls the robot saw
+// (the stub, the pillar, the cabinet, the outer walls) are in the map. plan_from_map: map frame -> plan's.
+void expectWallAccurateMap(const OccupancyGridData& map, const Pose2D& plan_from_map, const FloorPlan& room) {
+  int occupied = 0, on_wall = 0;
+  auto plan_point = [&](int ix, int iy) {
+    return plan_from_map.transform(Eigen::Vector2d(map.origin_x + (ix + 0.5) * map.resolution, map.origin_y + (iy + 0.5) * map.resolution));
+  };
+  for (int iy = 0; iy < map.height; ++iy) {
+    for (int ix = 0; ix < map.width; ++ix) {
+      if (map.at(ix, iy) < 65) continue;
+      ++occupied;
+      if (room.clearance(plan_point(ix, iy), 0.2) <= 0.06) ++on_wall;
+    }
+  }
+  EXPECT_GT(occupied, 400);
+  EXPECT_GT(on_wall, 0.97 * occupied) << on_wall << " of " << occupied << " occupied cells on the plan's walls";
+  auto occupied_near = [&](double x, double y) {  // plan-frame point: an occupied map cell within 0.1 m?
+    const Eigen::Vector2d m = plan_from_map.inverse().transform(Eigen::Vector2d(x, y));
+    const int cx = static_cast<int>(std::floor((m.x() - map.origin_x) / map.resolution));
+    const int cy = static_cast<int>(std::floor((m.y() - map.origin_y) / map.resolution));
+    for (int dy = -2; dy <= 2; ++dy) {
+      for (int dx = -2; dx <= 2; ++dx) {
+        const int ix = cx + dx, iy = cy + dy;
+        if (ix >= 0 && iy >= 0 && ix < map.width && iy < map.height && map.at(ix, iy) >= 65) return true;
+      }
+    }
+    return false;
+  };
+  for (double y = 0.6; y < 2.0; y += 0.2) EXPECT_TRUE(occupied_near(4.0, y)) << "stub, y " << y;       // wall stub face
+  for (double x = 5.85; x < 6.2; x += 0.1) EXPECT_TRUE(occupied_near(x, 3.8)) << "pillar, x " << x;   // pillar bottom
+  for (double x = 1.1; x < 2.4; x += 0.2) EXPECT_TRUE(occupied_near(x, 4.9)) << "cabinet, x " << x;   // cabinet front
+  for (double x = 2.0; x < 7.5; x += 0.5) EXPECT_TRUE(occupied_near(x, 0.1)) << "bottom wall, x " << x;
+  // Free space where the robot drove, unknown far outside.
+  const Eigen::Vector2d inside = plan_from_map.inverse().transform(Eigen::Vector2d(3.0, 3.0));
+  EXPECT_EQ(map.at(static_cast<int>((inside.x() - map.origin_x) / map.resolution),
+                   static_cast<int>((inside.y() - map.origin_y) / map.resolution)), 0);
+}
+
 }  // namespace
 
 TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
@@ -149,43 +187,10 @@ TEST(DpSlam, ClosesASimulatedLoopWithBoundedErrorAndAWallAccurateMap) {
   }
   EXPECT_LT(err_out, err_lineage) << std::sqrt(err_out / traj.size()) << " against " << std::sqrt(err_lineage / traj.size());
   EXPECT_LT(jitter_out, 0.5 * jitter_lineage) << jitter_out << " against " << jitter_lineage;
-  // The map's walls are the floor plan's: occupied cells lie on the plan's walls, and the walls the robot
-  // saw (the stub, the pillar, the cabinet, the outer walls) are in the map.
+  // The map's walls are the floor plan's.
   const OccupancyGridData map = slam.bestMap();
   ASSERT_GT(map.width, 0);
-  int occupied = 0, on_wall = 0;
-  auto plan_point = [&](int ix, int iy) {
-    return plan_from_map.transform(Eigen::Vector2d(map.origin_x + (ix + 0.5) * map.resolution, map.origin_y + (iy + 0.5) * map.resolution));
-  };
-  for (int iy = 0; iy < map.height; ++iy) {
-    for (int ix = 0; ix < map.width; ++ix) {
-      if (map.at(ix, iy) < 65) continue;
-      ++occupied;
-      if (room.clearance(plan_point(ix, iy), 0.2) <= 0.06) ++on_wall;
-    }
-  }
-  EXPECT_GT(occupied, 400);
-  EXPECT_GT(on_wall, 0.97 * occupied) << on_wall << " of " << occupied << " occupied cells on the plan's walls";
-  auto occupied_near = [&](double x, double y) {  // plan-frame point: an occupied map cell within 0.1 m?
-    const Eigen::Vector2d m = plan_from_map.inverse().transform(Eigen::Vector2d(x, y));
-    const int cx = static_cast<int>(std::floor((m.x() - map.origin_x) / map.resolution));
-    const int cy = static_cast<int>(std::floor((m.y() - map.origin_y) / map.resolution));
-    for (int dy = -2; dy <= 2; ++dy) {
-      for (int dx = -2; dx <= 2; ++dx) {
-        const int ix = cx + dx, iy = cy + dy;
-        if (ix >= 0 && iy >= 0 && ix < map.width && iy < map.height && map.at(ix, iy) >= 65) return true;
-      }
-    }
-    return false;
-  };
-  for (double y = 0.6; y < 2.0; y += 0.2) EXPECT_TRUE(occupied_near(4.0, y)) << "stub, y " << y;       // wall stub face
-  for (double x = 5.85; x < 6.2; x += 0.1) EXPECT_TRUE(occupied_near(x, 3.8)) << "pillar, x " << x;   // pillar bottom
-  for (double x = 1.1; x < 2.4; x += 0.2) EXPECT_TRUE(occupied_near(x, 4.9)) << "cabinet, x " << x;   // cabinet front
-  for (double x = 2.0; x < 7.5; x += 0.5) EXPECT_TRUE(occupied_near(x, 0.1)) << "bottom wall, x " << x;
-  // Free space where the robot drove, unknown far outside.
-  const Eigen::Vector2d inside = plan_from_map.inverse().transform(Eigen::Vector2d(3.0, 3.0));
-  EXPECT_EQ(map.at(static_cast<int>((inside.x() - map.origin_x) / map.resolution),
-                   static_cast<int>((inside.y() - map.origin_y) / map.resolution)), 0);
+  expectWallAccurateMap(map, plan_from_map, room);
   std::sort(ms.begin(), ms.end());
   std::printf("[ DpSlam   ] %zu scans, %d particles: per-scan median %.2f ms, p95 %.2f ms, max %.2f ms; "
               "tree <= %zu nodes, <= %zu map entries (%.1f MB); end error %.3f m %.2f deg, max %.3f m; "

@@ -106,6 +106,30 @@ class DifferentialEvolution {
 
   void validate(const Vector& lower, const Vector& upper, const std::vector<Vector>& seeds) const;
 
+  /// Storage beside the population, allocated once: the next generation (selection is synchronous) and
+  /// jDE's per-member F and CR, current and next.
+  struct Work {
+    std::vector<Vector> next;
+    std::vector<double> next_costs;
+    std::vector<double> f, cr, next_f, next_cr;
+  };
+  /// Whether spread_tolerance is set (its size is dim and some component is positive).
+  bool spreadCheckOn(Eigen::Index dim) const;
+  /// Every dimension's population range max−min is below spread_tolerance.
+  bool spreadConverged(const std::vector<Vector>& pop) const;
+  /// Index of the lowest cost (the first of equal ones).
+  static int bestIndex(const std::vector<double>& costs);
+  /// Clamped seeds first, then uniform in the box.
+  void initialPopulation(const Vector& lower, const Vector& upper, const std::vector<Vector>& seeds,
+                         std::vector<Vector>& pop, std::mt19937_64& rng) const;
+  /// One generation: a trial for every member, greedy selection, the survivors become r.population.
+  template <class Evaluate>
+  void generation(Evaluate& evaluate, const Vector& lower, const Vector& upper, int best, Result& r, Work& w,
+                  std::mt19937_64& rng) const;
+  /// Member i's trial vector: mutation by the strategy, binomial crossover, bound handling.
+  void buildTrial(int i, const std::vector<Vector>& pop, const Vector& xb, double f, double cr, const Vector& lower,
+                  const Vector& upper, Vector& trial, std::mt19937_64& rng) const;
+
   Config config_;
 };
 
@@ -140,48 +164,47 @@ void DifferentialEvolution<Dim>::validate(const Vector& lower, const Vector& upp
 }
 
 template <int Dim>
-template <class Cost>
-typename DifferentialEvolution<Dim>::Result DifferentialEvolution<Dim>::minimize(
-    Cost&& cost, const Vector& lower, const Vector& upper, const std::vector<Vector>& seeds,
-    std::mt19937_64& rng) const {
-  validate(lower, upper, seeds);
+bool DifferentialEvolution<Dim>::spreadCheckOn(Eigen::Index dim) const {
   const Config& c = config_;
-  const int np = c.population;
-  const Eigen::Index dim = lower.size();
-  const double inf = std::numeric_limits<double>::infinity();
-  auto evaluate = [&cost, inf](const Vector& x) -> double {
-    const double v = cost(static_cast<const Vector&>(x));
-    return std::isnan(v) ? inf : v;  // NaN would defeat the greedy comparison
-  };
-
   bool use_spread = c.spread_tolerance.size() == dim;
   if (use_spread) {
     use_spread = false;
     for (Eigen::Index j = 0; j < dim; ++j) use_spread = use_spread || c.spread_tolerance(j) > 0.0;
   }
+  return use_spread;
+}
 
-  // All storage is allocated here; the generation loop below allocates nothing (also for Eigen::Dynamic).
-  Result r;
-  std::vector<Vector>& pop = r.population;
-  std::vector<double>& costs = r.costs;
-  pop.assign(static_cast<size_t>(np), lower);
-  costs.assign(static_cast<size_t>(np), inf);
-  std::vector<Vector> next(static_cast<size_t>(np), lower);
-  std::vector<double> next_costs(static_cast<size_t>(np), inf);
-  // jDE per-member parameters (Brest et al. 2006); unused otherwise.
-  std::vector<double> f_i, cr_i, next_f, next_cr;
-  if (c.jde) {
-    f_i.assign(static_cast<size_t>(np), c.F);
-    cr_i.assign(static_cast<size_t>(np), c.CR);
-    next_f = f_i;
-    next_cr = cr_i;
+template <int Dim>
+bool DifferentialEvolution<Dim>::spreadConverged(const std::vector<Vector>& pop) const {
+  const int np = static_cast<int>(pop.size());
+  for (Eigen::Index j = 0; j < pop[0].size(); ++j) {
+    double lo = pop[0](j), hi = pop[0](j);
+    for (int i = 1; i < np; ++i) {
+      lo = std::min(lo, pop[i](j));
+      hi = std::max(hi, pop[i](j));
+    }
+    if (!(hi - lo < config_.spread_tolerance(j))) return false;
   }
+  return true;
+}
 
-  // Initial population: clamped seeds first, then uniform in the box.
-  const size_t n_seeds = std::min(seeds.size(), static_cast<size_t>(np));
-  for (size_t k = 0; k < static_cast<size_t>(np); ++k) {
+template <int Dim>
+int DifferentialEvolution<Dim>::bestIndex(const std::vector<double>& costs) {
+  int b = 0;
+  for (int i = 1; i < static_cast<int>(costs.size()); ++i) {
+    if (costs[i] < costs[b]) b = i;
+  }
+  return b;
+}
+
+template <int Dim>
+void DifferentialEvolution<Dim>::initialPopulation(const Vector& lower, const Vector& upper,
+                                                   const std::vector<Vector>& seeds, std::vector<Vector>& pop,
+                                                   std::mt19937_64& rng) const {
+  const size_t n_seeds = std::min(seeds.size(), pop.size());
+  for (size_t k = 0; k < pop.size(); ++k) {
     Vector& x = pop[k];
-    for (Eigen::Index j = 0; j < dim; ++j) {
+    for (Eigen::Index j = 0; j < lower.size(); ++j) {
       if (k < n_seeds) {
         x(j) = std::min(std::max(seeds[k](j), lower(j)), upper(j));
       } else {
@@ -189,130 +212,160 @@ typename DifferentialEvolution<Dim>::Result DifferentialEvolution<Dim>::minimize
       }
     }
   }
-  for (int i = 0; i < np; ++i) costs[i] = evaluate(pop[i]);
+}
+
+template <int Dim>
+template <class Cost>
+typename DifferentialEvolution<Dim>::Result DifferentialEvolution<Dim>::minimize(
+    Cost&& cost, const Vector& lower, const Vector& upper, const std::vector<Vector>& seeds,
+    std::mt19937_64& rng) const {
+  validate(lower, upper, seeds);
+  const Config& c = config_;
+  const int np = c.population;
+  const double inf = std::numeric_limits<double>::infinity();
+  auto evaluate = [&cost, inf](const Vector& x) -> double {
+    const double v = cost(static_cast<const Vector&>(x));
+    return std::isnan(v) ? inf : v;  // NaN would defeat the greedy comparison
+  };
+  const bool use_spread = spreadCheckOn(lower.size());
+
+  // All storage is allocated here; the generation loop below allocates nothing (also for Eigen::Dynamic).
+  Result r;
+  r.population.assign(static_cast<size_t>(np), lower);
+  r.costs.assign(static_cast<size_t>(np), inf);
+  Work w;
+  w.next.assign(static_cast<size_t>(np), lower);
+  w.next_costs.assign(static_cast<size_t>(np), inf);
+  // jDE per-member parameters (Brest et al. 2006); unused otherwise.
+  if (c.jde) {
+    w.f.assign(static_cast<size_t>(np), c.F);
+    w.cr.assign(static_cast<size_t>(np), c.CR);
+    w.next_f = w.f;
+    w.next_cr = w.cr;
+  }
+
+  initialPopulation(lower, upper, seeds, r.population, rng);
+  for (int i = 0; i < np; ++i) r.costs[i] = evaluate(r.population[i]);
   r.evaluations = np;
 
-  auto findBest = [&]() {
-    int b = 0;
-    for (int i = 1; i < np; ++i) {
-      if (costs[i] < costs[b]) b = i;
-    }
-    return b;
-  };
-  int best = findBest();
-  double best_cost = costs[best];
+  int best = bestIndex(r.costs);
+  double best_cost = r.costs[best];
   int stall = 0;
-
-  auto spreadConverged = [&]() {
-    for (Eigen::Index j = 0; j < dim; ++j) {
-      double lo = pop[0](j), hi = pop[0](j);
-      for (int i = 1; i < np; ++i) {
-        lo = std::min(lo, pop[i](j));
-        hi = std::max(hi, pop[i](j));
-      }
-      if (!(hi - lo < c.spread_tolerance(j))) return false;
-    }
-    return true;
-  };
-
-  constexpr double kTau1 = 0.1, kTau2 = 0.1, kFl = 0.1, kFu = 0.9;  // jDE constants (Brest et al. 2006)
-
   for (int gen = 0; gen < c.max_generations; ++gen) {
-    if (use_spread && spreadConverged()) break;
+    if (use_spread && spreadConverged(r.population)) break;
     if (c.stall_generations > 0 && stall >= c.stall_generations) break;
-
-    // Dither (Storn & Price): one F ~ U(0.5, 1) for the whole generation.
-    const double f_gen = (c.dither && !c.jde) ? 0.5 + 0.5 * uniform(rng) : c.F;
-    const Vector& xb = pop[best];
-
-    for (int i = 0; i < np; ++i) {
-      double f = f_gen, cr = c.CR;
-      if (c.jde) {
-        f = uniform(rng) < kTau1 ? kFl + kFu * uniform(rng) : f_i[i];
-        cr = uniform(rng) < kTau2 ? uniform(rng) : cr_i[i];
-      }
-
-      // Distinct random indices, all different from i (r3 only needed by rand/1).
-      int r1, r2, r3 = -1;
-      do { r1 = uniformIndex(rng, np); } while (r1 == i);
-      do { r2 = uniformIndex(rng, np); } while (r2 == i || r2 == r1);
-      if (c.strategy == Strategy::kRand1Bin) {
-        do { r3 = uniformIndex(rng, np); } while (r3 == i || r3 == r1 || r3 == r2);
-      }
-      const Vector& xi = pop[i];
-      const Vector& a = pop[r1];
-      const Vector& b = pop[r2];
-      // The base vector of the mutation (inside the box): bounce-back moves towards it.
-      const Vector& base = c.strategy == Strategy::kRand1Bin ? a
-                           : c.strategy == Strategy::kBest1Bin ? xb
-                                                                : xi;
-
-      // Binomial crossover with a guaranteed j_rand (Storn & Price 1997): the trial differs from x_i in
-      // at least one component even when CR = 0.
-      const Eigen::Index j_rand = uniformIndex(rng, static_cast<int>(dim));
-      Vector& trial = next[i];
-      for (Eigen::Index j = 0; j < dim; ++j) {
-        if (j != j_rand && !(uniform(rng) < cr)) {
-          trial(j) = xi(j);
-          continue;
-        }
-        double v;
-        switch (c.strategy) {
-          case Strategy::kRand1Bin: v = a(j) + f * (b(j) - pop[r3](j)); break;
-          case Strategy::kBest1Bin: v = xb(j) + f * (a(j) - b(j)); break;
-          default: v = xi(j) + f * (xb(j) - xi(j)) + f * (a(j) - b(j)); break;
-        }
-        if (v < lower(j) || v > upper(j)) {
-          const double bound = v < lower(j) ? lower(j) : upper(j);
-          if (c.bounds == BoundHandling::kBounceBack) {
-            v = base(j) + uniform(rng) * (bound - base(j));
-          } else {
-            v = lower(j) + uniform(rng) * (upper(j) - lower(j));
-          }
-          // Only guards against floating-point rounding of the lines above (at most an ulp).
-          v = std::min(std::max(v, lower(j)), upper(j));
-        }
-        trial(j) = v;
-      }
-
-      // Greedy selection (≤, Storn & Price): the trial replaces its target if it is not worse.
-      const double tc = evaluate(trial);
-      ++r.evaluations;
-      if (tc <= costs[i]) {
-        next_costs[i] = tc;
-        if (c.jde) {
-          next_f[i] = f;
-          next_cr[i] = cr;
-        }
-      } else {
-        trial = xi;
-        next_costs[i] = costs[i];
-        if (c.jde) {
-          next_f[i] = f_i[i];
-          next_cr[i] = cr_i[i];
-        }
-      }
-    }
-
-    pop.swap(next);
-    costs.swap(next_costs);
-    if (c.jde) {
-      f_i.swap(next_f);
-      cr_i.swap(next_cr);
-    }
+    generation(evaluate, lower, upper, best, r, w, rng);
     ++r.generations;
-    best = findBest();
-    if (costs[best] < best_cost) {
-      best_cost = costs[best];
+    best = bestIndex(r.costs);
+    if (r.costs[best] < best_cost) {
+      best_cost = r.costs[best];
       stall = 0;
     } else {
       ++stall;
     }
   }
 
-  r.best = pop[best];
-  r.best_cost = costs[best];
+  r.best = r.population[best];
+  r.best_cost = r.costs[best];
   return r;
+}
+
+template <int Dim>
+template <class Evaluate>
+void DifferentialEvolution<Dim>::generation(Evaluate& evaluate, const Vector& lower, const Vector& upper, int best,
+                                            Result& r, Work& w, std::mt19937_64& rng) const {
+  const Config& c = config_;
+  const int np = c.population;
+  constexpr double kTau1 = 0.1, kTau2 = 0.1, kFl = 0.1, kFu = 0.9;  // jDE constants (Brest et al. 2006)
+  // Dither (Storn & Price): one F ~ U(0.5, 1) for the whole generation.
+  const double f_gen = (c.dither && !c.jde) ? 0.5 + 0.5 * uniform(rng) : c.F;
+  const std::vector<Vector>& pop = r.population;
+  const Vector& xb = pop[best];
+
+  for (int i = 0; i < np; ++i) {
+    double f = f_gen, cr = c.CR;
+    if (c.jde) {
+      f = uniform(rng) < kTau1 ? kFl + kFu * uniform(rng) : w.f[i];
+      cr = uniform(rng) < kTau2 ? uniform(rng) : w.cr[i];
+    }
+    Vector& trial = w.next[i];
+    buildTrial(i, pop, xb, f, cr, lower, upper, trial, rng);
+
+    // Greedy selection (≤, Storn & Price): the trial replaces its target if it is not worse.
+    const double tc = evaluate(trial);
+    ++r.evaluations;
+    if (tc <= r.costs[i]) {
+      w.next_costs[i] = tc;
+      if (c.jde) {
+        w.next_f[i] = f;
+        w.next_cr[i] = cr;
+      }
+    } else {
+      trial = pop[i];
+      w.next_costs[i] = r.costs[i];
+      if (c.jde) {
+        w.next_f[i] = w.f[i];
+        w.next_cr[i] = w.cr[i];
+      }
+    }
+  }
+
+  r.population.swap(w.next);
+  r.costs.swap(w.next_costs);
+  if (c.jde) {
+    w.f.swap(w.next_f);
+    w.cr.swap(w.next_cr);
+  }
+}
+
+template <int Dim>
+void DifferentialEvolution<Dim>::buildTrial(int i, const std::vector<Vector>& pop, const Vector& xb, double f,
+                                            double cr, const Vector& lower, const Vector& upper, Vector& trial,
+                                            std::mt19937_64& rng) const {
+  const Config& c = config_;
+  const int np = c.population;
+  // Distinct random indices, all different from i (r3 only needed by rand/1).
+  int r1, r2, r3 = -1;
+  do { r1 = uniformIndex(rng, np); } while (r1 == i);
+  do { r2 = uniformIndex(rng, np); } while (r2 == i || r2 == r1);
+  if (c.strategy == Strategy::kRand1Bin) {
+    do { r3 = uniformIndex(rng, np); } while (r3 == i || r3 == r1 || r3 == r2);
+  }
+  const Vector& xi = pop[i];
+  const Vector& a = pop[r1];
+  const Vector& b = pop[r2];
+  // The base vector of the mutation (inside the box): bounce-back moves towards it.
+  const Vector& base = c.strategy == Strategy::kRand1Bin ? a
+                       : c.strategy == Strategy::kBest1Bin ? xb
+                                                            : xi;
+
+  // Binomial crossover with a guaranteed j_rand (Storn & Price 1997): the trial differs from x_i in
+  // at least one component even when CR = 0.
+  const Eigen::Index dim = lower.size();
+  const Eigen::Index j_rand = uniformIndex(rng, static_cast<int>(dim));
+  for (Eigen::Index j = 0; j < dim; ++j) {
+    if (j != j_rand && !(uniform(rng) < cr)) {
+      trial(j) = xi(j);
+      continue;
+    }
+    double v;
+    switch (c.strategy) {
+      case Strategy::kRand1Bin: v = a(j) + f * (b(j) - pop[r3](j)); break;
+      case Strategy::kBest1Bin: v = xb(j) + f * (a(j) - b(j)); break;
+      default: v = xi(j) + f * (xb(j) - xi(j)) + f * (a(j) - b(j)); break;
+    }
+    if (v < lower(j) || v > upper(j)) {
+      const double bound = v < lower(j) ? lower(j) : upper(j);
+      if (c.bounds == BoundHandling::kBounceBack) {
+        v = base(j) + uniform(rng) * (bound - base(j));
+      } else {
+        v = lower(j) + uniform(rng) * (upper(j) - lower(j));
+      }
+      // Only guards against floating-point rounding of the lines above (at most an ulp).
+      v = std::min(std::max(v, lower(j)), upper(j));
+    }
+    trial(j) = v;
+  }
 }
 
 }  // namespace laser_dpslam

@@ -132,6 +132,29 @@ class ScanMatcher {
   Eigen::Matrix3d boundedByWindow(const Eigen::Matrix3d& cov) const;
 
  private:
+  /// What the steps of one match() share.
+  struct MatchInput {
+    const std::vector<Eigen::Vector2d>& search_points;
+    const std::vector<Eigen::Vector2d>& polish_points;
+    const Pose2D& prior;
+    double prior_sigma_xy;
+    double n;  ///< polish_points.size()
+  };
+  /// DE over ±w around the prior on the raster, the prior seeded into the population; counts into r.
+  Pose2D deSearch(const MatchInput& in, const Eigen::Vector3d& w, std::mt19937_64& rng, MatchResult& r) const;
+  /// Newton polish coarse to fine from `pose`, its exact score at the finest level into *s.
+  Pose2D polishAll(const MatchInput& in, Pose2D pose, NdtScore* s, MatchResult& r, bool with_prior = true) const;
+  static double scorePerPoint(const MatchInput& in, const NdtScore& s);
+  bool isWeak(const MatchInput& in, const NdtScore& s) const;
+  /// The polish from the prior replaces *pose when it is lower in h plus the prior's term.
+  void polishFromPrior(const MatchInput& in, Pose2D* pose, NdtScore* s, MatchResult& r) const;
+  /// The prior and a wider DE search, polished; one replaces *pose when it scores clearly better.
+  void rescueWeak(const MatchInput& in, const std::mt19937_64& rng, Pose2D* pose, NdtScore* s, MatchResult& r) const;
+  /// Where *s is degenerate: *pose moved back to the prior along the weak direction, re-polished across it.
+  void keepPriorAlongWeak(const MatchInput& in, Pose2D* pose, NdtScore* s, MatchResult& r) const;
+  /// The polish without the prior replaces *pose when it scores clearly better far enough along `weak`.
+  void releasePrior(const MatchInput& in, const Eigen::Vector2d& weak, double prior_sigma, Pose2D* pose, NdtScore* s,
+                    MatchResult& r) const;
   Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& result) const;
   /// True when H's translation block has a direction the scan barely constrains (degeneracy_ratio); that
   /// direction (unit) into *weak.

@@ -163,6 +163,25 @@ class LaserOdometry {
   Pose2D priorDelta(double stamp, bool* from_wheels) const;
   /// process() in the matching frame: u.pose, u.pose_covariance and pose_ are in it.
   OdometryUpdate processInFrame(const PreprocessedScan& scan, const LaserMount& mount);
+  /// A scan with nothing to match: the pose moves by the motion prior, u says why.
+  void propagateUnmatched(const PreprocessedScan& scan, OdometryUpdate& u);
+  /// The first usable scan: the matching frame, the first keyframe.
+  void start(const PreprocessedScan& scan, const std::vector<Eigen::Vector2d>& base_points, OdometryUpdate& u);
+  /// The scan's match against the local map from `prior`, into u.match (and u.points_used).
+  void matchToLocalMap(const PreprocessedScan& scan, const LaserMount& mount,
+                       const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior, double dt,
+                       OdometryUpdate& u);
+  /// u.delta_covariance and pose_covariance_ from the match, `previous` the pose before it.
+  void matchCovariances(const Pose2D& previous, OdometryUpdate& u);
+  /// velocity_ (and the range flow) after a match `dt` after the last one.
+  void updateVelocity(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous, double dt,
+                      OdometryUpdate& u);
+  /// velocity_ along a degenerate match's weak direction: held, or moved by the range flow.
+  void velocityAlongCorridor(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous,
+                             double dt, const Eigen::Vector2d& before, const Eigen::Vector3d& measured,
+                             OdometryUpdate& u);
+  /// The pose has moved or turned far enough from the newest keyframe, or the overlap with it dropped.
+  bool keyframeDue(const MatchResult& match);
   /// A pose of the matching frame in the odom frame.
   Pose2D toOdom(const Pose2D& p) const { return Pose2D(0.0, 0.0, -frame_angle_) * p; }
 

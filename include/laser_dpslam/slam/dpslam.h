@@ -195,6 +195,21 @@ class DpSlam {
   /// Applies the planned writes of who[s] under nodes[s] (single-threaded, in order).
   void applyWrites(const std::vector<int>& who, const std::vector<int>& nodes);
   void filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d& cov, DpSlamUpdate& u);
+  /// Steps 1-3 of filterStep: every particle's new pose into chosen, its log-likelihood there into ll.
+  void propose(const Pose2D& delta, const Eigen::Matrix3d& cov, std::vector<Pose2D>& chosen,
+               std::vector<double>& ll);
+  /// The improved proposal (refine_iterations > 0); L the proposal noise's factor.
+  void proposeRefined(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
+                      std::vector<double>& ll);
+  /// Sampled candidates, the best of `oversampling` per particle by the cheap score, then scored.
+  void proposeSampled(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
+                      std::vector<double>& ll);
+  /// Steps 5-6: the surviving lineages' scan writes when due, the ancestry tree's new generation.
+  void updateMapAndTree(const Pose2D& delta, const std::vector<int>& parents, const std::vector<Pose2D>& chosen,
+                        DpSlamUpdate& u);
+  /// Each particle j takes its parent's pose and weight; best_ follows the best parent.
+  void adoptSurvivors(const std::vector<int>& parents, const std::vector<Pose2D>& chosen, int best_parent,
+                      bool resampled);
   void record(double stamp);
   void fill(DpSlamUpdate& u) const;
 

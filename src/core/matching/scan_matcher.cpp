@@ -152,6 +152,105 @@ Eigen::Matrix3d ScanMatcher::boundedByWindow(const Eigen::Matrix3d& cov) const {
   return f.asDiagonal() * c * f.asDiagonal();
 }
 
+Pose2D ScanMatcher::deSearch(const MatchInput& in, const Eigen::Vector3d& w, std::mt19937_64& rng,
+                             MatchResult& r) const {
+  using DE = DifferentialEvolution<3>;
+  DE::Config dc;
+  dc.population = config_.de_population;
+  dc.max_generations = config_.de_generations;
+  dc.F = config_.de_F;
+  dc.CR = config_.de_CR;
+  dc.dither = config_.de_dither;
+  dc.strategy = DE::Strategy::kRand1Bin;
+  dc.spread_tolerance = Eigen::Vector3d(config_.de_spread_xy, config_.de_spread_xy, config_.de_spread_theta);
+  dc.stall_generations = config_.de_stall_generations;
+  const Eigen::Vector3d p0 = in.prior.vector();
+  // θ is searched unwrapped around the prior; normalised when the pose is formed.
+  auto cost = [&](const Eigen::Vector3d& x) { return raster_.cost(Pose2D(x.x(), x.y(), x.z()), in.search_points); };
+  const DE de(dc);
+  const DE::Result res = de.minimize(cost, p0 - w, p0 + w, {p0}, rng);
+  r.de_generations += res.generations;
+  r.de_evaluations += res.evaluations;
+  return Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
+}
+
+Pose2D ScanMatcher::polishAll(const MatchInput& in, Pose2D pose, NdtScore* s, MatchResult& r, bool with_prior) const {
+  // (The finest level's polish already scored its final pose: that score is reused.)
+  bool scored = false;
+  for (std::size_t level = 0; level < grids_.size(); ++level) {
+    if (grids_[level].empty()) continue;
+    pose = polish(in.polish_points, pose, level, &r.newton_iterations, nullptr, with_prior ? &in.prior : nullptr,
+                  in.prior_sigma_xy, s);
+    scored = level + 1 == grids_.size();
+  }
+  if (!scored) *s = grids_.back().score(pose, in.polish_points, true);
+  return pose;
+}
+
+double ScanMatcher::scorePerPoint(const MatchInput& in, const NdtScore& s) {
+  return -s.h / (4.0 * in.n);  // in [0, 1]
+}
+
+bool ScanMatcher::isWeak(const MatchInput& in, const NdtScore& s) const {
+  return scorePerPoint(in, s) < config_.weak_score || s.matched / in.n < config_.weak_matched_fraction;
+}
+
+void ScanMatcher::polishFromPrior(const MatchInput& in, Pose2D* pose, NdtScore* s, MatchResult& r) const {
+  const Pose2D& prior = in.prior;
+  const double w = priorWeight(in.prior_sigma_xy);
+  auto objective = [&](const Pose2D& p, const NdtScore& sc) {
+    return sc.h + 0.5 * w * ((p.x - prior.x) * (p.x - prior.x) + (p.y - prior.y) * (p.y - prior.y));
+  };
+  NdtScore ps;
+  const Pose2D from_prior = polishAll(in, prior, &ps, r);
+  if (objective(from_prior, ps) < objective(*pose, *s)) {
+    *pose = from_prior;
+    *s = ps;
+  }
+}
+
+void ScanMatcher::rescueWeak(const MatchInput& in, const std::mt19937_64& rng, Pose2D* pose, NdtScore* s,
+                             MatchResult& r) const {
+  // A copy of the generator: a retry leaves the caller's random stream, and so every later match, as it
+  // would be without it.
+  std::mt19937_64 retry_rng = rng;
+  retry_rng.discard(1);
+  const Pose2D wide = deSearch(in, Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.rescue_window_theta),
+                               retry_rng, r);
+  for (const Pose2D& st : {in.prior, wide}) {
+    NdtScore cs;
+    const Pose2D cand = polishAll(in, st, &cs, r);
+    if (scorePerPoint(in, cs) > scorePerPoint(in, *s) + config_.rescue_margin) {
+      *pose = cand;
+      *s = cs;
+    }
+  }
+}
+
+void ScanMatcher::keepPriorAlongWeak(const MatchInput& in, Pose2D* pose, NdtScore* s, MatchResult& r) const {
+  Eigen::Vector2d v;
+  if (!degenerate(s->hessian, &v)) return;
+  const Eigen::Vector2d d(pose->x - in.prior.x, pose->y - in.prior.y);
+  const Eigen::Vector2d xy = Eigen::Vector2d(pose->x, pose->y) - v * v.dot(d);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
+  basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
+  *pose = polish(in.polish_points, Pose2D(xy.x(), xy.y(), pose->theta), grids_.size() - 1, &r.newton_iterations,
+                 &basis);
+  *s = grids_.back().score(*pose, in.polish_points, true);
+}
+
+void ScanMatcher::releasePrior(const MatchInput& in, const Eigen::Vector2d& weak, double prior_sigma, Pose2D* pose,
+                               NdtScore* s, MatchResult& r) const {
+  NdtScore fs;
+  const Pose2D free = polishAll(in, *pose, &fs, r, false);
+  if (scorePerPoint(in, fs) > scorePerPoint(in, *s) + config_.prior_release_margin &&
+      std::abs(weak.dot(Eigen::Vector2d(free.x - pose->x, free.y - pose->y))) > config_.prior_release_sigmas * prior_sigma) {
+    *pose = free;
+    *s = fs;
+    r.prior_released = true;
+  }
+}
+
 MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
                                const std::vector<Eigen::Vector2d>& polish_points, const Pose2D& prior,
                                std::mt19937_64& rng, double prior_sigma_xy, bool allow_prior_release,
@@ -159,97 +258,32 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   MatchResult r;
   r.pose = prior;
   if (!hasReference() || points.empty() || polish_points.empty()) return r;
+  const MatchInput in{points, polish_points, prior, prior_sigma_xy, static_cast<double>(polish_points.size())};
 
-  // DE over a window around the prior (doc/algorithms.md §3), the prior seeded into the population.
-  auto deSearch = [&](const Eigen::Vector3d& w, std::mt19937_64& rng) {
-    using DE = DifferentialEvolution<3>;
-    DE::Config dc;
-    dc.population = config_.de_population;
-    dc.max_generations = config_.de_generations;
-    dc.F = config_.de_F;
-    dc.CR = config_.de_CR;
-    dc.dither = config_.de_dither;
-    dc.strategy = DE::Strategy::kRand1Bin;
-    dc.spread_tolerance = Eigen::Vector3d(config_.de_spread_xy, config_.de_spread_xy, config_.de_spread_theta);
-    dc.stall_generations = config_.de_stall_generations;
-    const Eigen::Vector3d p0 = prior.vector();
-    // θ is searched unwrapped around the prior; normalised when the pose is formed.
-    auto cost = [&](const Eigen::Vector3d& x) { return raster_.cost(Pose2D(x.x(), x.y(), x.z()), points); };
-    const DE de(dc);
-    const DE::Result res = de.minimize(cost, p0 - w, p0 + w, {p0}, rng);
-    r.de_generations += res.generations;
-    r.de_evaluations += res.evaluations;
-    return Pose2D(res.best.x(), res.best.y(), normalizeAngle(res.best.z()));
-  };
-  // Newton polish coarse to fine, then the exact score at the finest resolution.
-  // (The finest level's polish already scored its final pose: that score is reused.)
-  auto polishAll = [&](Pose2D pose, NdtScore* s, bool with_prior = true) {
-    bool scored = false;
-    for (std::size_t level = 0; level < grids_.size(); ++level) {
-      if (grids_[level].empty()) continue;
-      pose = polish(polish_points, pose, level, &r.newton_iterations, nullptr, with_prior ? &prior : nullptr,
-                    prior_sigma_xy, s);
-      scored = level + 1 == grids_.size();
-    }
-    if (!scored) *s = grids_.back().score(pose, polish_points, true);
-    return pose;
-  };
-  const double n = static_cast<double>(polish_points.size());
-  auto scorePerPoint = [&](const NdtScore& s) { return -s.h / (4.0 * n); };  // in [0, 1]
-  auto isWeak = [&](const NdtScore& s) {
-    return scorePerPoint(s) < config_.weak_score || s.matched / n < config_.weak_matched_fraction;
-  };
+  // DE over a window around the prior (doc/algorithms.md §3), the prior seeded into the population; then
+  // the Newton polish coarse to fine, and the exact score at the finest resolution.
   const bool de = config_.use_de && !raster_.empty();
   NdtScore s;
-  Pose2D pose = polishAll(de ? deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng) : prior, &s);
+  Pose2D pose = polishAll(in, de ? deSearch(in, Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng, r) : prior, &s, r);
   const double prior_sigma = priorSigma(prior_sigma_xy);
   if (de && prior_sigma > 0.0 && std::hypot(pose.x - prior.x, pose.y - prior.y) > 3.0 * prior_sigma) {
     // The polish minimises h plus the soft prior, but DE searched h alone (on the raster) and may hand it a
     // basin far from the prior (a corridor's flat score, a false optimum 0.2 m back). Polish from the prior
     // too and keep the lower value of that same objective.
-    const double w = priorWeight(prior_sigma_xy);
-    auto objective = [&](const Pose2D& p, const NdtScore& sc) {
-      return sc.h + 0.5 * w * ((p.x - prior.x) * (p.x - prior.x) + (p.y - prior.y) * (p.y - prior.y));
-    };
-    NdtScore ps;
-    const Pose2D from_prior = polishAll(prior, &ps);
-    if (objective(from_prior, ps) < objective(pose, s)) {
-      pose = from_prior;
-      s = ps;
-    }
+    polishFromPrior(in, &pose, &s, r);
   }
-  if (config_.rescue_margin > 0.0 && de && isWeak(s)) {
+  if (config_.rescue_margin > 0.0 && de && isWeak(in, s)) {
     // A weak match is often a wrong one (a fast turn starting: the constant-velocity prior is off and the
     // search ends on a false optimum). Try the prior itself and a search over a wider window; take one only
     // if it scores clearly better, so that the flat optima of corridors are not traded for one another.
     // (Without DE the match already started from the prior: nothing to retry.)
-    // A copy of the generator: a retry leaves the caller's random stream, and so every later match, as it
-    // would be without it.
-    std::mt19937_64 retry_rng = rng;
-    retry_rng.discard(1);
-    const Pose2D wide = deSearch(Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.rescue_window_theta), retry_rng);
-    for (const Pose2D& st : {prior, wide}) {
-      NdtScore cs;
-      const Pose2D cand = polishAll(st, &cs);
-      if (scorePerPoint(cs) > scorePerPoint(s) + config_.rescue_margin) {
-        pose = cand;
-        s = cs;
-      }
-    }
+    rescueWeak(in, rng, &pose, &s, r);
   }
   if (config_.keep_prior_when_degenerate || hold_prior_when_degenerate) {
     // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
     // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
     // (LOAM-style solution remapping, Zhang et al. 2016).
-    Eigen::Vector2d v;
-    if (degenerate(s.hessian, &v)) {
-      const Eigen::Vector2d d(pose.x - prior.x, pose.y - prior.y);
-      const Eigen::Vector2d xy = Eigen::Vector2d(pose.x, pose.y) - v * v.dot(d);
-      Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
-      basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
-      pose = polish(polish_points, Pose2D(xy.x(), xy.y(), pose.theta), grids_.size() - 1, &r.newton_iterations, &basis);
-      s = grids_.back().score(pose, polish_points, true);
-    }
+    keepPriorAlongWeak(in, &pose, &s, r);
   }
   Eigen::Vector2d weak;
   if (allow_prior_release && prior_sigma > 0.0 && degenerate(s.hessian, &weak)) {
@@ -258,21 +292,14 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     // follows the held motion only slowly and metres are lost in seconds (the loop building's start). The
     // scan then fits clearly better where it really is: polish again without the prior and take that
     // when it scores higher and lies well outside the prior's σ along the weak direction.
-    NdtScore fs;
-    const Pose2D free = polishAll(pose, &fs, false);
-    if (scorePerPoint(fs) > scorePerPoint(s) + config_.prior_release_margin &&
-        std::abs(weak.dot(Eigen::Vector2d(free.x - pose.x, free.y - pose.y))) > config_.prior_release_sigmas * prior_sigma) {
-      pose = free;
-      s = fs;
-      r.prior_released = true;
-    }
+    releasePrior(in, weak, prior_sigma, &pose, &s, r);
   }
   r.pose = pose;
 
   r.hessian = s.hessian;
-  r.score_per_point = scorePerPoint(s);
-  r.matched_fraction = static_cast<double>(s.matched) / n;
-  r.weak = isWeak(s);
+  r.score_per_point = scorePerPoint(in, s);
+  r.matched_fraction = static_cast<double>(s.matched) / in.n;
+  r.weak = isWeak(in, s);
   r.covariance = covarianceFrom(s.hessian, prior_sigma > 0.0, r);
   r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
   if (!r.valid) r.pose = prior;

@@ -161,53 +161,101 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
 
   const std::vector<Eigen::Vector2d> base_points = mount.apply(scan.points);
   if (!scan.ok() || static_cast<int>(base_points.size()) < config_.min_points) {
-    // Nothing to match: propagate with the velocity prior (bounded by the gap rule) and say so.
-    const double dt = initialized_ ? scan.stamp - last_stamp_ : 0.0;
-    if (initialized_ && dt > 0.0) {
-      const Pose2D d = priorDelta(scan.stamp, &u.wheel_prior);
-      if (u.wheel_prior || dt <= config_.max_prior_gap) {
-        pose_ = pose_ * d;
-        u.delta = d;
-        last_stamp_ = scan.stamp;
-      }
-    }
-    if (u.skip_reason == OdometrySkipReason::kNone) {
-      u.skip_reason = scan.ok() ? OdometrySkipReason::kTooFewPoints : OdometrySkipReason::kMalformedScan;
-    }
-    u.pose = pose_;
-    u.pose_covariance = pose_covariance_;
-    u.velocity = velocity_;
+    propagateUnmatched(scan, u);
     return u;
   }
-
   if (!initialized_) {
-    initialized_ = true;
-    last_stamp_ = scan.stamp;
-    frame_angle_ = 0.0;
-    if (config_.align_to_walls) {
-      // Walls at angle a in the base frame lie along the axes of a frame in which the robot heads −a.
-      const WallDirection w = dominantWallDirection(base_points);
-      if (w.strength >= config_.wall_alignment_min_strength) frame_angle_ = -w.angle;
-    }
-    pose_ = Pose2D(0.0, 0.0, frame_angle_);
-    pose_covariance_.setZero();
-    velocity_.setZero();
-    addKeyframe(base_points);
-    previous_scan_ = scan;
-    last_flow_ = RangeFlow();  // a flow from before a reset says nothing about this start
-    u.ok = true;
-    u.reset = true;
-    u.new_keyframe = true;
-    u.pose = pose_;
-    u.delta_covariance = Eigen::Matrix3d::Zero();
-    u.points_used = static_cast<int>(base_points.size());
-    ++scan_count_;
+    start(scan, base_points, u);
     return u;
   }
 
   const double dt = scan.stamp - last_stamp_;
   const Pose2D prior = pose_ * priorDelta(scan.stamp, &u.wheel_prior);
+  matchToLocalMap(scan, mount, base_points, prior, dt, u);
+  if (!u.match.valid) {
+    u.skip_reason = OdometrySkipReason::kMatchFailed;
+    pose_ = prior;
+    previous_scan_ = scan;
+    last_flow_ = RangeFlow();
+    last_stamp_ = scan.stamp;
+    u.pose = pose_;
+    u.pose_covariance = pose_covariance_;
+    return u;
+  }
 
+  const Pose2D previous = pose_;
+  pose_ = u.match.pose;
+  u.delta = between(previous, pose_);
+  matchCovariances(previous, u);
+  if (dt > 0.0 && dt <= config_.max_prior_gap) {
+    updateVelocity(scan, mount, previous, dt, u);
+  } else {
+    last_flow_ = RangeFlow();
+    velocity_.setZero();
+    constrained_stamp_ = kNoConstrainedMatch;  // nothing measured to hold
+  }
+  if (!u.match.degenerate && !u.match.weak) constrained_stamp_ = scan.stamp;
+  last_stamp_ = scan.stamp;
+
+  if (keyframeDue(u.match)) {
+    addKeyframe(base_points);
+    u.new_keyframe = true;
+  }
+  previous_scan_ = scan;
+  u.ok = true;
+  u.pose = pose_;
+  u.pose_covariance = pose_covariance_;
+  u.velocity = velocity_;
+  return u;
+}
+
+void LaserOdometry::propagateUnmatched(const PreprocessedScan& scan, OdometryUpdate& u) {
+  // Nothing to match: propagate with the velocity prior (bounded by the gap rule) and say so.
+  const double dt = initialized_ ? scan.stamp - last_stamp_ : 0.0;
+  if (initialized_ && dt > 0.0) {
+    const Pose2D d = priorDelta(scan.stamp, &u.wheel_prior);
+    if (u.wheel_prior || dt <= config_.max_prior_gap) {
+      pose_ = pose_ * d;
+      u.delta = d;
+      last_stamp_ = scan.stamp;
+    }
+  }
+  if (u.skip_reason == OdometrySkipReason::kNone) {
+    u.skip_reason = scan.ok() ? OdometrySkipReason::kTooFewPoints : OdometrySkipReason::kMalformedScan;
+  }
+  u.pose = pose_;
+  u.pose_covariance = pose_covariance_;
+  u.velocity = velocity_;
+}
+
+void LaserOdometry::start(const PreprocessedScan& scan, const std::vector<Eigen::Vector2d>& base_points,
+                          OdometryUpdate& u) {
+  initialized_ = true;
+  last_stamp_ = scan.stamp;
+  frame_angle_ = 0.0;
+  if (config_.align_to_walls) {
+    // Walls at angle a in the base frame lie along the axes of a frame in which the robot heads −a.
+    const WallDirection w = dominantWallDirection(base_points);
+    if (w.strength >= config_.wall_alignment_min_strength) frame_angle_ = -w.angle;
+  }
+  pose_ = Pose2D(0.0, 0.0, frame_angle_);
+  pose_covariance_.setZero();
+  velocity_.setZero();
+  addKeyframe(base_points);
+  previous_scan_ = scan;
+  last_flow_ = RangeFlow();  // a flow from before a reset says nothing about this start
+  u.ok = true;
+  u.reset = true;
+  u.new_keyframe = true;
+  u.pose = pose_;
+  u.delta_covariance = Eigen::Matrix3d::Zero();
+  u.points_used = static_cast<int>(base_points.size());
+  ++scan_count_;
+}
+
+void LaserOdometry::matchToLocalMap(const PreprocessedScan& scan, const LaserMount& mount,
+                                    const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior, double dt,
+                                    OdometryUpdate& u) {
   PreprocessedScan trimmed;
   const bool trim = trimToMatchRange(scan, config_.match_range_margin, config_.min_points, &trimmed);
   const PreprocessedScan& near = trim ? trimmed : scan;
@@ -228,20 +276,9 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   const bool may_release = !u.wheel_prior && config_.prior_release_speed > 0.0 &&
                            velocity_.head<2>().norm() < config_.prior_release_speed;
   u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release, u.wheel_prior);
-  if (!u.match.valid) {
-    u.skip_reason = OdometrySkipReason::kMatchFailed;
-    pose_ = prior;
-    previous_scan_ = scan;
-    last_flow_ = RangeFlow();
-    last_stamp_ = scan.stamp;
-    u.pose = pose_;
-    u.pose_covariance = pose_covariance_;
-    return u;
-  }
+}
 
-  const Pose2D previous = pose_;
-  pose_ = u.match.pose;
-  u.delta = between(previous, pose_);
+void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) {
   // The match covariance is in the odom frame; the delta's lives in the previous base frame.
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   R.topLeftCorner<2, 2>() = previous.rotation();
@@ -262,74 +299,68 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   Eigen::Matrix3d Ja, Jb;
   composeJacobians(kf.pose, between(kf.pose, pose_), &Ja, &Jb);
   pose_covariance_ = Ja * kf.covariance * Ja.transpose() + u.match.bounded_covariance;
-  if (dt > 0.0 && dt <= config_.max_prior_gap) {
-    // Translation: exponential smoothing (velocity_gain). Taking the last motion as the velocity feeds any
-    // small per-match bias along a corridor back into the prior, where it adds up twice (a lag growing with
-    // the square of the scans: maps come out too short); the smoothing scales that feedback by the gain.
-    // Rotation: the last motion (turns start and stop fast; the heading is well constrained anyway).
-    const Eigen::Vector3d measured = Eigen::Vector3d(u.delta.x, u.delta.y, u.delta.theta) / dt;
-    const double g = config_.velocity_gain;
-    const Eigen::Vector2d before = velocity_.head<2>();
-    velocity_.head<2>() = (1.0 - g) * before + g * measured.head<2>();
-    const double gw = config_.degenerate_velocity_gain;
-    const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
-                             scan.range_max <= config_.degenerate_velocity_max_range;
-    // A released prior was refuted by the scan: nothing left to hold.
-    if (u.match.prior_released) constrained_stamp_ = kNoConstrainedMatch;
-    const bool hold = config_.degenerate_hold_time > 0.0 && constrained_stamp_ != kNoConstrainedMatch &&
-                      scan.stamp - constrained_stamp_ <= config_.degenerate_hold_time;
-    if (short_range && u.match.degenerate) {
-      const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
-      if (config_.range_flow_gain > 0.0 && previous_scan_.stamp == last_stamp_) {
-        u.range_flow = measureRangeFlow(previous_scan_, scan, mount, u.delta, weak, dt, config_.range_flow);
-      }
-      const double before_w = weak.dot(before);
-      // Only two consecutive flows that agree, and together refute the velocity, move it: one scan's flow is
-      // noisier than the match's smoothed velocity (an edge, something moving: one flow can be far off) and a
-      // few per cent off near edges, so within 3σ of their mean (and 0.02 m/s) the velocity stays as the rules
-      // below make it. A robot that stops or starts in a corridor is far outside.
-      // (The last flow's direction is in the matching frame; a weak direction's sign is arbitrary.)
-      const double turn = last_flow_direction_.dot(u.match.weak_direction);
-      const RangeFlow& b = u.range_flow;
-      const double a_speed = turn < 0.0 ? -last_flow_.speed : last_flow_.speed;
-      const double mean = 0.5 * (a_speed + b.speed), sigma = 0.5 * std::hypot(last_flow_.sigma, b.sigma);
-      const bool refutes = last_flow_.valid && b.valid && std::abs(turn) > 0.99 &&
-                           std::abs(a_speed - b.speed) <= 3.0 * std::hypot(last_flow_.sigma, b.sigma) &&
-                           std::abs(mean - before_w) > 3.0 * sigma + 0.02;
-      u.range_flow_applied = refutes;
-      if (refutes) {
-        // The speed along the corridor measured against the previous scans, not the local map.
-        velocity_.head<2>() += weak * (before_w + config_.range_flow_gain * (mean - before_w) - weak.dot(velocity_.head<2>()));
-      } else if (gw >= 0.0 || hold) {
-        velocity_.head<2>() += weak * (((hold ? 0.0 : gw) - g) * weak.dot(measured.head<2>() - before));
-      }
-    }
-    velocity_.z() = measured.z();
-    last_flow_ = u.range_flow;
-    last_flow_direction_ = u.match.weak_direction;
-  } else {
-    last_flow_ = RangeFlow();
-    velocity_.setZero();
-    constrained_stamp_ = kNoConstrainedMatch;  // nothing measured to hold
-  }
-  if (!u.match.degenerate && !u.match.weak) constrained_stamp_ = scan.stamp;
-  last_stamp_ = scan.stamp;
+}
 
-  const Pose2D from_kf = between(keyframes_.back().pose, pose_);
-  if (keyframe_matched_ < 0.0) keyframe_matched_ = u.match.matched_fraction;
-  const bool overlap_dropped = config_.keyframe_overlap_drop > 0.0 &&
-                               u.match.matched_fraction < keyframe_matched_ - config_.keyframe_overlap_drop;
-  if (std::hypot(from_kf.x, from_kf.y) > config_.keyframe_distance ||
-      std::abs(from_kf.theta) > config_.keyframe_angle || overlap_dropped) {
-    addKeyframe(base_points);
-    u.new_keyframe = true;
+void LaserOdometry::updateVelocity(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous,
+                                   double dt, OdometryUpdate& u) {
+  // Translation: exponential smoothing (velocity_gain). Taking the last motion as the velocity feeds any
+  // small per-match bias along a corridor back into the prior, where it adds up twice (a lag growing with
+  // the square of the scans: maps come out too short); the smoothing scales that feedback by the gain.
+  // Rotation: the last motion (turns start and stop fast; the heading is well constrained anyway).
+  const Eigen::Vector3d measured = Eigen::Vector3d(u.delta.x, u.delta.y, u.delta.theta) / dt;
+  const double g = config_.velocity_gain;
+  const Eigen::Vector2d before = velocity_.head<2>();
+  velocity_.head<2>() = (1.0 - g) * before + g * measured.head<2>();
+  const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
+                           scan.range_max <= config_.degenerate_velocity_max_range;
+  // A released prior was refuted by the scan: nothing left to hold.
+  if (u.match.prior_released) constrained_stamp_ = kNoConstrainedMatch;
+  if (short_range && u.match.degenerate) velocityAlongCorridor(scan, mount, previous, dt, before, measured, u);
+  velocity_.z() = measured.z();
+  last_flow_ = u.range_flow;
+  last_flow_direction_ = u.match.weak_direction;
+}
+
+void LaserOdometry::velocityAlongCorridor(const PreprocessedScan& scan, const LaserMount& mount,
+                                          const Pose2D& previous, double dt, const Eigen::Vector2d& before,
+                                          const Eigen::Vector3d& measured, OdometryUpdate& u) {
+  const double g = config_.velocity_gain;
+  const double gw = config_.degenerate_velocity_gain;
+  const bool hold = config_.degenerate_hold_time > 0.0 && constrained_stamp_ != kNoConstrainedMatch &&
+                    scan.stamp - constrained_stamp_ <= config_.degenerate_hold_time;
+  const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
+  if (config_.range_flow_gain > 0.0 && previous_scan_.stamp == last_stamp_) {
+    u.range_flow = measureRangeFlow(previous_scan_, scan, mount, u.delta, weak, dt, config_.range_flow);
   }
-  previous_scan_ = scan;
-  u.ok = true;
-  u.pose = pose_;
-  u.pose_covariance = pose_covariance_;
-  u.velocity = velocity_;
-  return u;
+  const double before_w = weak.dot(before);
+  // Only two consecutive flows that agree, and together refute the velocity, move it: one scan's flow is
+  // noisier than the match's smoothed velocity (an edge, something moving: one flow can be far off) and a
+  // few per cent off near edges, so within 3σ of their mean (and 0.02 m/s) the velocity stays as the rules
+  // below make it. A robot that stops or starts in a corridor is far outside.
+  // (The last flow's direction is in the matching frame; a weak direction's sign is arbitrary.)
+  const double turn = last_flow_direction_.dot(u.match.weak_direction);
+  const RangeFlow& b = u.range_flow;
+  const double a_speed = turn < 0.0 ? -last_flow_.speed : last_flow_.speed;
+  const double mean = 0.5 * (a_speed + b.speed), sigma = 0.5 * std::hypot(last_flow_.sigma, b.sigma);
+  const bool refutes = last_flow_.valid && b.valid && std::abs(turn) > 0.99 &&
+                       std::abs(a_speed - b.speed) <= 3.0 * std::hypot(last_flow_.sigma, b.sigma) &&
+                       std::abs(mean - before_w) > 3.0 * sigma + 0.02;
+  u.range_flow_applied = refutes;
+  if (refutes) {
+    // The speed along the corridor measured against the previous scans, not the local map.
+    velocity_.head<2>() += weak * (before_w + config_.range_flow_gain * (mean - before_w) - weak.dot(velocity_.head<2>()));
+  } else if (gw >= 0.0 || hold) {
+    velocity_.head<2>() += weak * (((hold ? 0.0 : gw) - g) * weak.dot(measured.head<2>() - before));
+  }
+}
+
+bool LaserOdometry::keyframeDue(const MatchResult& match) {
+  const Pose2D from_kf = between(keyframes_.back().pose, pose_);
+  if (keyframe_matched_ < 0.0) keyframe_matched_ = match.matched_fraction;
+  const bool overlap_dropped = config_.keyframe_overlap_drop > 0.0 &&
+                               match.matched_fraction < keyframe_matched_ - config_.keyframe_overlap_drop;
+  return std::hypot(from_kf.x, from_kf.y) > config_.keyframe_distance ||
+         std::abs(from_kf.theta) > config_.keyframe_angle || overlap_dropped;
 }
 
 }  // namespace laser_dpslam

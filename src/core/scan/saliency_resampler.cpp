@@ -35,23 +35,11 @@ void binOf(double angle, int bins, int& b0, int& b1, double& w1) {
   b1 = (b0 + 1) % bins;
 }
 
-}  // namespace
-
-SaliencyFeatures computeSaliency(const PreprocessedScan& scan, const SaliencyConfig& cfg) {
+// §4.2 Segments and edges. Near endpoint of a jump = occluding edge; far endpoint = shadow (the first
+// background point behind an occluder moves with the viewpoint). Shadow wins when a point is both (a mixed
+// pixel floating between two surfaces).
+void findSegmentsAndEdges(const PreprocessedScan& scan, const SaliencyConfig& cfg, SaliencyFeatures& f) {
   const std::size_t n = scan.points.size();
-  const std::vector<Eigen::Vector2d>& p = scan.points;
-  SaliencyFeatures f;
-  f.segment.assign(n, 0);
-  f.curvature.assign(n, 0.0);
-  f.normal_angle.assign(n, -1.0);
-  f.rarity.assign(n, 0.0);
-  f.edge.assign(n, EdgeType::kNone);
-  f.score.assign(n, 0.0);
-  if (n == 0) return f;
-
-  // §4.2 Segments and edges. Near endpoint of a jump = occluding edge; far endpoint = shadow (the
-  // first background point behind an occluder moves with the viewpoint). Shadow wins when a point is
-  // both (a mixed pixel floating between two surfaces).
   std::vector<char> occluding(n, 0), shadow(n, 0);
   int seg = 0;
   for (std::size_t i = 1; i < n; ++i) {
@@ -68,59 +56,80 @@ SaliencyFeatures computeSaliency(const PreprocessedScan& scan, const SaliencyCon
   }
   for (std::size_t i = 0; i < n; ++i)
     f.edge[i] = shadow[i] ? EdgeType::kShadow : occluding[i] ? EdgeType::kOccluding : EdgeType::kNone;
+}
 
-  // §4.3 Curvature from a PCA of the neighbourhood (same segment, within the radius, at most ±k beams):
-  // c = λ2/(λ1+λ2) is 0 on a line and 0.5 on an isotropic blob. Each neighbour is weighted by the arc
-  // length it stands for (half its two gaps), so the PCA sees the surface, not the sampling density:
-  // unweighted, the denser wall of a corner dominates and the curvature peak slides off the corner.
+// The arc length each point stands for: half its two gaps within its segment, at most the radius.
+std::vector<double> arcLengths(const std::vector<Eigen::Vector2d>& p, const std::vector<int>& segment, double radius) {
+  const std::size_t n = p.size();
   std::vector<double> arc(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     double w = 0.0;
-    if (i > 0 && f.segment[i - 1] == f.segment[i]) w += 0.5 * (p[i] - p[i - 1]).norm();
-    if (i + 1 < n && f.segment[i + 1] == f.segment[i]) w += 0.5 * (p[i + 1] - p[i]).norm();
-    arc[i] = std::min(w, std::max(cfg.neighbour_radius, 0.0)) + 1e-9;  // > 0: isolated points still count
+    if (i > 0 && segment[i - 1] == segment[i]) w += 0.5 * (p[i] - p[i - 1]).norm();
+    if (i + 1 < n && segment[i + 1] == segment[i]) w += 0.5 * (p[i + 1] - p[i]).norm();
+    arc[i] = std::min(w, std::max(radius, 0.0)) + 1e-9;  // > 0: isolated points still count
   }
+  return arc;
+}
+
+// The weighted PCA of point i's neighbourhood (same segment, within √r2, at most ±k beams): its curvature
+// and normal angle into f (left as they are with fewer than 2 neighbours).
+void neighbourhoodPca(const std::vector<Eigen::Vector2d>& p, const std::vector<double>& arc, std::size_t i,
+                      std::size_t k, double r2, SaliencyFeatures& f) {
+  const std::size_t n = p.size();
+  const std::size_t j0 = i >= k ? i - k : 0;
+  const std::size_t j1 = std::min(n - 1, i + k);
+  double sw = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
+  int cnt = 0;
+  std::size_t other = i;  // some neighbour other than i, for the 2-point case
+  for (std::size_t j = j0; j <= j1; ++j) {
+    if (f.segment[j] != f.segment[i]) continue;
+    const Eigen::Vector2d d = p[j] - p[i];  // centred on p_i for numerical stability
+    if (d.squaredNorm() > r2) continue;
+    const double w = arc[j];
+    sw += w;
+    sx += w * d.x();
+    sy += w * d.y();
+    sxx += w * d.x() * d.x();
+    sxy += w * d.x() * d.y();
+    syy += w * d.y() * d.y();
+    ++cnt;
+    if (j != i) other = j;
+  }
+  if (cnt >= 3) {
+    const double mx = sx / sw, my = sy / sw;
+    const double a = sxx / sw - mx * mx, b = sxy / sw - mx * my, d = syy / sw - my * my;
+    const double tr = a + d;
+    const double disc = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
+    const double l2 = std::max(0.0, 0.5 * tr - disc);
+    if (tr > 1e-12) f.curvature[i] = std::min(0.5, l2 / tr);
+    // Major axis at 0.5·atan2(2b, a−d); the normal is perpendicular to it.
+    f.normal_angle[i] = foldAngle(0.5 * std::atan2(2.0 * b, a - d) + 0.5 * M_PI);
+  } else if (cnt == 2) {
+    const Eigen::Vector2d d = p[other] - p[i];
+    if (d.squaredNorm() > 0.0) f.normal_angle[i] = foldAngle(std::atan2(d.y(), d.x()) + 0.5 * M_PI);
+  }
+}
+
+// §4.3 Curvature from a PCA of the neighbourhood: c = λ2/(λ1+λ2) is 0 on a line and 0.5 on an isotropic
+// blob. Each neighbour is weighted by the arc length it stands for, so the PCA sees the surface, not the
+// sampling density: unweighted, the denser wall of a corner dominates and the curvature peak slides off the
+// corner. Returns the largest curvature.
+double curvatureAndNormals(const std::vector<Eigen::Vector2d>& p, const SaliencyConfig& cfg, SaliencyFeatures& f) {
+  const std::vector<double> arc = arcLengths(p, f.segment, cfg.neighbour_radius);
   const std::size_t k = static_cast<std::size_t>(std::max(1, cfg.neighbours));
   const double r2 = cfg.neighbour_radius * cfg.neighbour_radius;
   double c_max = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t j0 = i >= k ? i - k : 0;
-    const std::size_t j1 = std::min(n - 1, i + k);
-    double sw = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
-    int cnt = 0;
-    std::size_t other = i;  // some neighbour other than i, for the 2-point case
-    for (std::size_t j = j0; j <= j1; ++j) {
-      if (f.segment[j] != f.segment[i]) continue;
-      const Eigen::Vector2d d = p[j] - p[i];  // centred on p_i for numerical stability
-      if (d.squaredNorm() > r2) continue;
-      const double w = arc[j];
-      sw += w;
-      sx += w * d.x();
-      sy += w * d.y();
-      sxx += w * d.x() * d.x();
-      sxy += w * d.x() * d.y();
-      syy += w * d.y() * d.y();
-      ++cnt;
-      if (j != i) other = j;
-    }
-    if (cnt >= 3) {
-      const double mx = sx / sw, my = sy / sw;
-      const double a = sxx / sw - mx * mx, b = sxy / sw - mx * my, d = syy / sw - my * my;
-      const double tr = a + d;
-      const double disc = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
-      const double l2 = std::max(0.0, 0.5 * tr - disc);
-      if (tr > 1e-12) f.curvature[i] = std::min(0.5, l2 / tr);
-      // Major axis at 0.5·atan2(2b, a−d); the normal is perpendicular to it.
-      f.normal_angle[i] = foldAngle(0.5 * std::atan2(2.0 * b, a - d) + 0.5 * M_PI);
-    } else if (cnt == 2) {
-      const Eigen::Vector2d d = p[other] - p[i];
-      if (d.squaredNorm() > 0.0) f.normal_angle[i] = foldAngle(std::atan2(d.y(), d.x()) + 0.5 * M_PI);
-    }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    neighbourhoodPca(p, arc, i, k, r2, f);
     c_max = std::max(c_max, f.curvature[i]);
   }
+  return c_max;
+}
 
-  // §4.4 Orientation rarity: points facing a rare direction (a corridor's end wall) constrain the
-  // direction the rest of the scan leaves unobservable.
+// §4.4 Orientation rarity: points facing a rare direction (a corridor's end wall) constrain the direction
+// the rest of the scan leaves unobservable.
+void orientationRarity(const SaliencyConfig& cfg, SaliencyFeatures& f) {
+  const std::size_t n = f.normal_angle.size();
   const int bins = std::max(1, cfg.orientation_bins);
   std::vector<double> hist(bins, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
@@ -140,58 +149,30 @@ SaliencyFeatures computeSaliency(const PreprocessedScan& scan, const SaliencyCon
     const double h = (1.0 - w1) * hist[b0] + w1 * hist[b1];
     f.rarity[i] = std::clamp(1.0 - h / h_max, 0.0, 1.0);
   }
-
-  // §4.5 Score.
-  for (std::size_t i = 0; i < n; ++i) {
-    const double c = c_max > 0.0 ? f.curvature[i] / c_max : 0.0;
-    double s = cfg.weight_curvature * c + cfg.weight_rarity * f.rarity[i] +
-               cfg.weight_edge * (f.edge[i] == EdgeType::kOccluding ? 1.0 : 0.0);
-    if (f.edge[i] == EdgeType::kShadow) s = cfg.drop_shadow_points ? 0.0 : s * cfg.shadow_weight;
-    f.score[i] = std::isfinite(s) ? std::max(0.0, s) : 0.0;
-  }
-  return f;
 }
 
-std::vector<int> saliencyResample(const PreprocessedScan& scan, std::size_t budget, const SaliencyConfig& cfg,
-                                  std::uint64_t seed) {
-  const std::size_t n = scan.points.size();
-  const std::vector<Eigen::Vector2d>& p = scan.points;
-  if (n == 0 || budget == 0) return {};
-  const SaliencyFeatures f = computeSaliency(scan, cfg);
-
-  std::vector<char> eligible(n, 1);
-  std::size_t n_eligible = n;
-  if (cfg.drop_shadow_points) {
-    for (std::size_t i = 0; i < n; ++i)
-      if (f.edge[i] == EdgeType::kShadow) eligible[i] = 0, --n_eligible;
-  }
-  std::vector<int> out;
-  if (budget >= n_eligible) {
-    for (std::size_t i = 0; i < n; ++i)
-      if (eligible[i]) out.push_back(static_cast<int>(i));
-    return out;
-  }
-  out.reserve(budget);
-  std::vector<char> chosen(n, 0);
-
-  // Phase 1: about salient_fraction·budget points by score, no two closer than min_spacing (so one
-  // corner does not take several slots). Keys: the score itself, or Efraimidis–Spirakis keys
-  // log(u)/w for weighted sampling without replacement (one u per point, drawn in index order).
-  const double frac = std::clamp(std::isfinite(cfg.salient_fraction) ? cfg.salient_fraction : 0.0, 0.0, 1.0);
-  const std::size_t n_salient = std::min(budget, static_cast<std::size_t>(std::lround(frac * budget)));
+// Phase 1's keys: the score itself, or Efraimidis–Spirakis keys log(u)/w for weighted sampling without
+// replacement (one u per point, drawn in index order).
+std::vector<double> samplingKeys(const SaliencyFeatures& f, const SaliencyConfig& cfg, std::uint64_t seed) {
   std::vector<double> key(f.score);
   if (cfg.weighted_sampling) {
     std::mt19937_64 rng(seed);
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < key.size(); ++i) {
       // u in (0, 1] from the raw 64 bits: identical on every standard library, unlike the distributions.
       const double u = (static_cast<double>(rng() >> 11) + 1.0) * 0x1.0p-53;
       const double w = std::pow(f.score[i], cfg.sampling_exponent);
       key[i] = (w > 0.0 && std::isfinite(w)) ? std::log(u) / w : -std::numeric_limits<double>::infinity();
     }
   }
-  // Candidates are local score maxima (over the PCA neighbourhood): the points around a corner share
-  // its high score, and without this the sampler often takes one of them and the spacing then blocks
-  // the corner itself.
+  return key;
+}
+
+// Phase 1's candidates: local score maxima (over the PCA neighbourhood), in index order. The points around a
+// corner share its high score, and without this the sampler often takes one of them and the spacing then
+// blocks the corner itself.
+std::vector<int> localScoreMaxima(const std::vector<Eigen::Vector2d>& p, const SaliencyFeatures& f,
+                                  const SaliencyConfig& cfg, const std::vector<char>& eligible) {
+  const std::size_t n = p.size();
   const std::size_t k = static_cast<std::size_t>(std::max(1, cfg.neighbours));
   const double r2 = cfg.neighbour_radius * cfg.neighbour_radius;
   std::vector<int> order;
@@ -204,6 +185,18 @@ std::vector<int> saliencyResample(const PreprocessedScan& scan, std::size_t budg
       is_max = !(f.segment[j] == f.segment[i] && f.score[j] > f.score[i] && (p[j] - p[i]).squaredNorm() <= r2);
     if (is_max) order.push_back(static_cast<int>(i));
   }
+  return order;
+}
+
+// Phase 1: about salient_fraction·budget points by key, no two closer than min_spacing (so one corner does
+// not take several slots), into out and chosen.
+void pickSalient(const std::vector<Eigen::Vector2d>& p, const SaliencyFeatures& f, const SaliencyConfig& cfg,
+                 const std::vector<char>& eligible, std::size_t budget, std::uint64_t seed, std::vector<int>& out,
+                 std::vector<char>& chosen) {
+  const double frac = std::clamp(std::isfinite(cfg.salient_fraction) ? cfg.salient_fraction : 0.0, 0.0, 1.0);
+  const std::size_t n_salient = std::min(budget, static_cast<std::size_t>(std::lround(frac * budget)));
+  const std::vector<double> key = samplingKeys(f, cfg, seed);
+  std::vector<int> order = localScoreMaxima(p, f, cfg, eligible);
   std::stable_sort(order.begin(), order.end(), [&key](int a, int b) { return key[a] > key[b]; });
   const double sp2 = std::max(0.0, cfg.min_spacing) * std::max(0.0, cfg.min_spacing);
   for (int i : order) {
@@ -219,11 +212,15 @@ std::vector<int> saliencyResample(const PreprocessedScan& scan, std::size_t budg
     out.push_back(i);
     chosen[i] = 1;
   }
+}
 
-  // Phase 2: coverage by farthest-point sampling from what is already chosen: spatially uniform, so the
-  // dense clusters near the laser do not take the budget (the thesis's URG-04LX problem).
-  // O(n) per pick over plain arrays (the scan's hot loop after the NDT score): points that may not be
-  // picked carry −inf, which min() keeps and the arg-max never takes.
+// Phase 2: coverage by farthest-point sampling from what is already chosen, until out holds the budget:
+// spatially uniform, so the dense clusters near the laser do not take the budget (the thesis's URG-04LX
+// problem). O(n) per pick over plain arrays (the scan's hot loop after the NDT score): points that may not
+// be picked carry −inf, which min() keeps and the arg-max never takes.
+void coverFarthest(const std::vector<Eigen::Vector2d>& p, const std::vector<char>& eligible, std::size_t budget,
+                   std::vector<int>& out, std::vector<char>& chosen) {
+  const std::size_t n = p.size();
   std::vector<double> xs(n), ys(n), dist2(n, std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < n; ++i) {
     xs[i] = p[i].x();
@@ -255,6 +252,57 @@ std::vector<int> saliencyResample(const PreprocessedScan& scan, std::size_t budg
     dist2[best] = -std::numeric_limits<double>::infinity();
     best = pick(static_cast<std::size_t>(best));
   }
+}
+
+}  // namespace
+
+SaliencyFeatures computeSaliency(const PreprocessedScan& scan, const SaliencyConfig& cfg) {
+  const std::size_t n = scan.points.size();
+  SaliencyFeatures f;
+  f.segment.assign(n, 0);
+  f.curvature.assign(n, 0.0);
+  f.normal_angle.assign(n, -1.0);
+  f.rarity.assign(n, 0.0);
+  f.edge.assign(n, EdgeType::kNone);
+  f.score.assign(n, 0.0);
+  if (n == 0) return f;
+  findSegmentsAndEdges(scan, cfg, f);
+  const double c_max = curvatureAndNormals(scan.points, cfg, f);
+  orientationRarity(cfg, f);
+
+  // §4.5 Score.
+  for (std::size_t i = 0; i < n; ++i) {
+    const double c = c_max > 0.0 ? f.curvature[i] / c_max : 0.0;
+    double s = cfg.weight_curvature * c + cfg.weight_rarity * f.rarity[i] +
+               cfg.weight_edge * (f.edge[i] == EdgeType::kOccluding ? 1.0 : 0.0);
+    if (f.edge[i] == EdgeType::kShadow) s = cfg.drop_shadow_points ? 0.0 : s * cfg.shadow_weight;
+    f.score[i] = std::isfinite(s) ? std::max(0.0, s) : 0.0;
+  }
+  return f;
+}
+
+std::vector<int> saliencyResample(const PreprocessedScan& scan, std::size_t budget, const SaliencyConfig& cfg,
+                                  std::uint64_t seed) {
+  const std::size_t n = scan.points.size();
+  if (n == 0 || budget == 0) return {};
+  const SaliencyFeatures f = computeSaliency(scan, cfg);
+
+  std::vector<char> eligible(n, 1);
+  std::size_t n_eligible = n;
+  if (cfg.drop_shadow_points) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (f.edge[i] == EdgeType::kShadow) eligible[i] = 0, --n_eligible;
+  }
+  std::vector<int> out;
+  if (budget >= n_eligible) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (eligible[i]) out.push_back(static_cast<int>(i));
+    return out;
+  }
+  out.reserve(budget);
+  std::vector<char> chosen(n, 0);
+  pickSalient(scan.points, f, cfg, eligible, budget, seed, out, chosen);
+  coverFarthest(scan.points, eligible, budget, out, chosen);
   std::sort(out.begin(), out.end());
   return out;
 }

@@ -26,59 +26,45 @@ std::string num(double v) {
   return s.str();
 }
 
-}  // namespace
-
-PreprocessedScan preprocessScan(const LaserScan& scan, const ScanPreprocessorConfig& config) {
-  PreprocessedScan out;
-  out.stamp = scan.stamp;
+// Whole-scan checks: why the message is malformed, or "" when it is not.
+std::string scanError(const LaserScan& scan) {
   const std::size_t n = scan.ranges.size();
-  out.counts.total = n;
-
-  // --- Whole-scan checks: a malformed message gives an error and no points, never an exception. ---
-  if (n == 0) return fail(std::move(out), "scan has no ranges");
+  if (n == 0) return "scan has no ranges";
   if (n > kMaxBeams)
-    return fail(std::move(out), "scan has " + std::to_string(n) + " beams (more than " +
-                                    std::to_string(kMaxBeams) + ": not a planar laser)");
+    return "scan has " + std::to_string(n) + " beams (more than " + std::to_string(kMaxBeams) + ": not a planar laser)";
   if (!std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_max) || !std::isfinite(scan.angle_increment))
-    return fail(std::move(out), "non-finite angle field (angle_min " + num(scan.angle_min) + ", angle_max " +
-                                    num(scan.angle_max) + ", angle_increment " + num(scan.angle_increment) + ")");
-  if (scan.angle_increment == 0.0) return fail(std::move(out), "angle_increment is zero");
+    return "non-finite angle field (angle_min " + num(scan.angle_min) + ", angle_max " + num(scan.angle_max) +
+           ", angle_increment " + num(scan.angle_increment) + ")";
+  if (scan.angle_increment == 0.0) return "angle_increment is zero";
   if (std::abs(scan.angle_increment) > 2.0 * M_PI)
-    return fail(std::move(out), "angle_increment " + num(scan.angle_increment) + " rad exceeds a full turn");
+    return "angle_increment " + num(scan.angle_increment) + " rad exceeds a full turn";
   const double span = scan.angle_max - scan.angle_min;
   // Upside-down / mirrored lasers have angle_max < angle_min with a negative increment: fine if they agree.
   if (span != 0.0 && ((span > 0.0) != (scan.angle_increment > 0.0)))
-    return fail(std::move(out), "angle_increment " + num(scan.angle_increment) +
-                                    " has the wrong sign for angle_max - angle_min = " + num(span));
+    return "angle_increment " + num(scan.angle_increment) + " has the wrong sign for angle_max - angle_min = " +
+           num(span);
   if (!std::isfinite(scan.range_max) || scan.range_max <= 0.0)
-    return fail(std::move(out), "range_max " + num(scan.range_max) + " is not a positive finite number");
-  if (!std::isfinite(scan.range_min))
-    return fail(std::move(out), "range_min " + num(scan.range_min) + " is not finite");
+    return "range_max " + num(scan.range_max) + " is not a positive finite number";
+  if (!std::isfinite(scan.range_min)) return "range_min " + num(scan.range_min) + " is not finite";
   if (scan.range_min > scan.range_max)
-    return fail(std::move(out), "range_min " + num(scan.range_min) + " > range_max " + num(scan.range_max));
+    return "range_min " + num(scan.range_min) + " > range_max " + num(scan.range_max);
+  return "";
+}
 
-  // --- Configuration checks (a bad config is reported the same way; it is never silently ignored). ---
-  if (std::isnan(config.min_range)) return fail(std::move(out), "config min_range is NaN");
-  if (std::isnan(config.max_range)) return fail(std::move(out), "config max_range is NaN");
+// Configuration checks (a bad config is reported like a bad scan; it is never silently ignored).
+std::string configError(const ScanPreprocessorConfig& config) {
+  if (std::isnan(config.min_range)) return "config min_range is NaN";
+  if (std::isnan(config.max_range)) return "config max_range is NaN";
   if (std::isnan(config.angle_min) || std::isnan(config.angle_max) || config.angle_min > config.angle_max)
-    return fail(std::move(out), "config angle window [" + num(config.angle_min) + ", " + num(config.angle_max) +
-                                    "] is empty or NaN");
+    return "config angle window [" + num(config.angle_min) + ", " + num(config.angle_max) + "] is empty or NaN";
+  return "";
+}
 
-  // Effective range window: the tighter of the scan's and the config's; max_range <= 0 (or inf) = scan's.
-  const double lo = std::max(scan.range_min, config.min_range);
-  const double hi = (config.max_range > 0.0 && std::isfinite(config.max_range))
-                        ? std::min(scan.range_max, config.max_range)
-                        : scan.range_max;
-  if (lo > hi)
-    return fail(std::move(out), "effective range window [" + num(lo) + ", " + num(hi) + "] is empty");
-  // Ranges are float32 on the wire: compare them with the limits rounded to float, so that a reading of
-  // exactly range_min or range_max (as a float) is inside the window, not lost to rounding.
-  constexpr double kFloatMax = std::numeric_limits<float>::max();
-  const float lo_f = static_cast<float>(std::clamp(lo, -kFloatMax, kFloatMax));
-  const float hi_f = static_cast<float>(std::min(hi, kFloatMax));
-  out.range_max = std::max(hi, static_cast<double>(hi_f));
-
-  // --- Per-beam classification (REP-117). Plain loop, vectors reserved: this runs on every scan. ---
+// Per-beam classification (REP-117) against the range window [lo_f, hi_f] and the config's angle window.
+// Plain loop, vectors reserved: this runs on every scan.
+void classifyBeams(const LaserScan& scan, const ScanPreprocessorConfig& config, float lo_f, float hi_f,
+                   PreprocessedScan& out) {
+  const std::size_t n = scan.ranges.size();
   out.points.reserve(n);
   out.beams.reserve(n);
   out.ranges.reserve(n);
@@ -124,6 +110,34 @@ PreprocessedScan preprocessScan(const LaserScan& scan, const ScanPreprocessorCon
     out.ranges.push_back(r);
     out.angles.push_back(a);
   }
+}
+
+}  // namespace
+
+PreprocessedScan preprocessScan(const LaserScan& scan, const ScanPreprocessorConfig& config) {
+  PreprocessedScan out;
+  out.stamp = scan.stamp;
+  out.counts.total = scan.ranges.size();
+
+  // A malformed message gives an error and no points, never an exception.
+  std::string why = scanError(scan);
+  if (why.empty()) why = configError(config);
+  if (!why.empty()) return fail(std::move(out), why);
+
+  // Effective range window: the tighter of the scan's and the config's; max_range <= 0 (or inf) = scan's.
+  const double lo = std::max(scan.range_min, config.min_range);
+  const double hi = (config.max_range > 0.0 && std::isfinite(config.max_range))
+                        ? std::min(scan.range_max, config.max_range)
+                        : scan.range_max;
+  if (lo > hi)
+    return fail(std::move(out), "effective range window [" + num(lo) + ", " + num(hi) + "] is empty");
+  // Ranges are float32 on the wire: compare them with the limits rounded to float, so that a reading of
+  // exactly range_min or range_max (as a float) is inside the window, not lost to rounding.
+  constexpr double kFloatMax = std::numeric_limits<float>::max();
+  const float lo_f = static_cast<float>(std::clamp(lo, -kFloatMax, kFloatMax));
+  const float hi_f = static_cast<float>(std::min(hi, kFloatMax));
+  out.range_max = std::max(hi, static_cast<double>(hi_f));
+  classifyBeams(scan, config, lo_f, hi_f, out);
   return out;
 }
 

@@ -355,50 +355,9 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
 
 void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d& cov, DpSlamUpdate& u) {
   const int P = config_.particles;
-  const int K = config_.oversampling;
-  // 1. Proposal: each particle moves by the delta plus noise, in its own frame. Draws in a fixed order.
-  Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal);
-  // Exploring, the noise mostly random-walks the particles (their fresh maps move with them); back on old
-  // ground it is what lets the filter find the older map's alignment (doc/benchmarks.md).
-  const Pose2D ahead = poses_[best_] * delta;
-  last_revisit_ = revisit_.update(Eigen::Vector2d(ahead.x, ahead.y), std::hypot(delta.x, delta.y));
-  if (!last_revisit_) L *= config_.explore_noise_scale;
   std::vector<Pose2D> chosen(P);
   std::vector<double> ll(P);
-  for (auto& c : caches_) c.begin(tree_, leaves_);
-  if (config_.refine_iterations > 0) {
-    // Improved proposal: each particle climbs to the best fit of the scan on its own map from pose ⊕ delta,
-    // is weighted there (so the noise below does not make the weights peaky), and then moves by noise
-    // drawn from the proposal's covariance around that fit.
-    std::vector<Pose2D> noise(P);
-    for (int i = 0; i < P; ++i) noise[i] = sampleMotion(Pose2D(), L, rng_);
-    pool_->run(P, [&](std::size_t i, int w) {
-      const Pose2D fit = refine(poses_[i] * delta, static_cast<int>(i), caches_[w]);
-      ll[i] = score(fit, static_cast<int>(i), caches_[w]);
-      chosen[i] = fit * noise[i];
-    });
-  } else {
-    std::vector<Pose2D> candidates(static_cast<std::size_t>(P) * K);
-    for (int i = 0; i < P; ++i) {
-      for (int k = 0; k < K; ++k) candidates[static_cast<std::size_t>(i) * K + k] = poses_[i] * sampleMotion(delta, L, rng_);
-    }
-    // 2. Over-sampling: keep each particle's best candidate by the cheap endpoint score.
-    if (K > 1) {
-      std::vector<double> cheap(candidates.size());
-      cheapScoreAll(candidates, K, cheap);
-      for (int i = 0; i < P; ++i) {
-        int best = 0;
-        for (int k = 1; k < K; ++k) {
-          if (cheap[static_cast<std::size_t>(i) * K + k] > cheap[static_cast<std::size_t>(i) * K + best]) best = k;
-        }
-        chosen[i] = candidates[static_cast<std::size_t>(i) * K + best];
-      }
-    } else {
-      chosen = candidates;
-    }
-    // 3. Weights: the full observation model, one result per particle (independent of scheduling).
-    scoreAll(chosen, ll);
-  }
+  propose(delta, cov, chosen, ll);
   // Tempering: beams are not independent, so the product of their likelihoods is over-confident and
   // depletes the particles; an exponent < 1 keeps more hypotheses alive until a loop closes.
   for (int i = 0; i < P; ++i) {
@@ -415,10 +374,81 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
   } else {
     for (int i = 0; i < P; ++i) parents[i] = i;
   }
+  updateMapAndTree(delta, parents, chosen, u);
+  adoptSurvivors(parents, chosen, nw.best, resample);
+  last_neff_ = resample ? P : nw.neff;
+  pending_ = Pose2D();
+  pending_cov_.setZero();
+  record(stamp);
+  u.filter_updated = true;
+  u.resampled = resample;
+}
+
+void DpSlam::propose(const Pose2D& delta, const Eigen::Matrix3d& cov, std::vector<Pose2D>& chosen,
+                     std::vector<double>& ll) {
+  // 1. Proposal: each particle moves by the delta plus noise, in its own frame. Draws in a fixed order.
+  Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal);
+  // Exploring, the noise mostly random-walks the particles (their fresh maps move with them); back on old
+  // ground it is what lets the filter find the older map's alignment (doc/benchmarks.md).
+  const Pose2D ahead = poses_[best_] * delta;
+  last_revisit_ = revisit_.update(Eigen::Vector2d(ahead.x, ahead.y), std::hypot(delta.x, delta.y));
+  if (!last_revisit_) L *= config_.explore_noise_scale;
+  for (auto& c : caches_) c.begin(tree_, leaves_);
+  if (config_.refine_iterations > 0) {
+    proposeRefined(delta, L, chosen, ll);
+  } else {
+    proposeSampled(delta, L, chosen, ll);
+  }
+}
+
+void DpSlam::proposeRefined(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
+                            std::vector<double>& ll) {
+  // Improved proposal: each particle climbs to the best fit of the scan on its own map from pose ⊕ delta,
+  // is weighted there (so the noise below does not make the weights peaky), and then moves by noise
+  // drawn from the proposal's covariance around that fit.
+  const int P = config_.particles;
+  std::vector<Pose2D> noise(P);
+  for (int i = 0; i < P; ++i) noise[i] = sampleMotion(Pose2D(), L, rng_);
+  pool_->run(P, [&](std::size_t i, int w) {
+    const Pose2D fit = refine(poses_[i] * delta, static_cast<int>(i), caches_[w]);
+    ll[i] = score(fit, static_cast<int>(i), caches_[w]);
+    chosen[i] = fit * noise[i];
+  });
+}
+
+void DpSlam::proposeSampled(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
+                            std::vector<double>& ll) {
+  const int P = config_.particles;
+  const int K = config_.oversampling;
+  std::vector<Pose2D> candidates(static_cast<std::size_t>(P) * K);
+  for (int i = 0; i < P; ++i) {
+    for (int k = 0; k < K; ++k) candidates[static_cast<std::size_t>(i) * K + k] = poses_[i] * sampleMotion(delta, L, rng_);
+  }
+  // 2. Over-sampling: keep each particle's best candidate by the cheap endpoint score.
+  if (K > 1) {
+    std::vector<double> cheap(candidates.size());
+    cheapScoreAll(candidates, K, cheap);
+    for (int i = 0; i < P; ++i) {
+      int best = 0;
+      for (int k = 1; k < K; ++k) {
+        if (cheap[static_cast<std::size_t>(i) * K + k] > cheap[static_cast<std::size_t>(i) * K + best]) best = k;
+      }
+      chosen[i] = candidates[static_cast<std::size_t>(i) * K + best];
+    }
+  } else {
+    chosen = candidates;
+  }
+  // 3. Weights: the full observation model, one result per particle (independent of scheduling).
+  scoreAll(chosen, ll);
+}
+
+void DpSlam::updateMapAndTree(const Pose2D& delta, const std::vector<int>& parents, const std::vector<Pose2D>& chosen,
+                              DpSlamUpdate& u) {
   // 5. Map update, planned now (the scoring caches still describe the old particles): each surviving
   //    lineage writes the scan once, from its pose, into the node it will own alone after the ancestry
   //    update. Its descendants (all at that pose) see exactly what they would see had each written its own
   //    copy, without the copies.
+  const int P = config_.particles;
   since_map_update_ = since_map_update_ * delta;
   const bool due = travelThresholdReached(since_map_update_, config_.map_update_distance, config_.map_update_angle);
   std::vector<int> survivors;
@@ -436,26 +466,25 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
     since_map_update_ = Pose2D();
     u.map_updated = true;
   }
+}
+
+void DpSlam::adoptSurvivors(const std::vector<int>& parents, const std::vector<Pose2D>& chosen, int best_parent,
+                            bool resampled) {
+  const int P = config_.particles;
   std::vector<double> new_logw(P);
-  const double max_logw = logw_[nw.best];
+  const double max_logw = logw_[best_parent];
   best_ = 0;
   for (int j = 0; j < P; ++j) {
     poses_[j] = chosen[parents[j]];
-    new_logw[j] = resample ? 0.0 : logw_[parents[j]] - max_logw;
+    new_logw[j] = resampled ? 0.0 : logw_[parents[j]] - max_logw;
   }
   for (int j = 0; j < P; ++j) {
-    if (parents[j] == nw.best) {
+    if (parents[j] == best_parent) {
       best_ = j;
       break;
     }
   }
   logw_ = new_logw;
-  last_neff_ = resample ? P : nw.neff;
-  pending_ = Pose2D();
-  pending_cov_.setZero();
-  record(stamp);
-  u.filter_updated = true;
-  u.resampled = resample;
 }
 
 void DpSlam::fill(DpSlamUpdate& u) const {
