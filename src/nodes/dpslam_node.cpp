@@ -68,7 +68,9 @@ class DpSlamNode {
     save_srv_ = nh.advertiseService(names::kSaveMapService, &DpSlamNode::onSaveMap, this);
     updater_.setHardwareID("none");
     updater_.add("scan processing", this, &DpSlamNode::diagnose);
-    diagnostics_timer_ = nh.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) { updater_.update(); });
+    // Wall time: the status keeps coming while a bag is paused or over (ROS time then stands still).
+    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(updater_.getPeriod()),
+                                            [this](const ros::WallTimerEvent&) { updater_.force_update(); });
     ROS_INFO("dpslam_node: %s -> %s from TF %s -> %s, %d particles", map_frame_.c_str(), odom_frame_.c_str(),
              odom_frame_.c_str(), base_frame_.c_str(), slam_config_.particles);
     if (work_multiplier_ > 1.0) {
@@ -381,7 +383,7 @@ class DpSlamNode {
   ros::Publisher map_pub_, metadata_pub_, pose_pub_, path_pub_, particles_pub_;
   ros::Subscriber scan_sub_, odom_sub_;
   ros::ServiceServer map_srv_, save_srv_;
-  ros::Timer diagnostics_timer_;
+  ros::WallTimer diagnostics_timer_;
   diagnostic_updater::Updater updater_;
 
   std::mutex odom_mutex_;  ///< odom_window_, odom_newest_ns_ (the spinner writes them, the worker reads them)
