@@ -9,6 +9,8 @@
 #   ATE                         RMSE against bags/demo_ground_truth.tum (evaluate_trajectory, SE(2)
 #                               aligned) of the last `trajectory` path (up to the last map publication,
 #                               <= map_update_interval before the end) and of the live `pose`
+#   WARN/all                    dpslam_node's /diagnostics statuses that were WARN (scans skipped or lag
+#                               > 1 s in their second) / all of them
 # Usage: scripts/benchmark_lag.sh [--multipliers "1 3"] [--core 0] [--player-core 1]
 # The ROS master runs on a port of its own (BENCHMARK_PORT, default a free one); everything started here is
 # stopped at the end. Outputs in out/benchmark_lag/xM/.
@@ -58,7 +60,7 @@ wait_for() {  # wait_for SECONDS COMMAND...: until COMMAND succeeds
 }
 subscribed() { rostopic info /scan 2>/dev/null | grep -q dpslam_node; }
 
-printf "%-5s %9s %7s %10s %10s %10s %11s %11s\n" mult processed skipped "lag med s" "lag p95 s" "lag max s" "ATE traj m" "ATE pose m"
+printf "%-5s %9s %7s %10s %10s %10s %11s %11s %9s\n" mult processed skipped "lag med s" "lag p95 s" "lag max s" "ATE traj m" "ATE pose m" "WARN/all"
 for m in $MULTIPLIERS; do
   dir="$OUT/x$m"
   rm -rf "$dir"
@@ -97,8 +99,10 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 d = (s.get("diagnostics") or {}).get("values", {})
 f = lambda v: "-" if v is None else "%.3f" % v
-print("%-5s %9s %7s %10s %10s %10s %11s %11s" % (sys.argv[2], d.get("scans processed", "-"), d.get("scans skipped", "-"),
-      f(s["lag_median_s"]), f(s["lag_p95_s"]), f(s["lag_max_s"]), sys.argv[3], sys.argv[4]))
+levels = s.get("diagnostics_levels", {})
+warn = "%d/%d" % (levels.get("1", 0), sum(levels.values()))
+print("%-5s %9s %7s %10s %10s %10s %11s %11s %9s" % (sys.argv[2], d.get("scans processed", "-"), d.get("scans skipped", "-"),
+      f(s["lag_median_s"]), f(s["lag_p95_s"]), f(s["lag_max_s"]), sys.argv[3], sys.argv[4], warn))
 EOF
 done
 echo "(nodes on core $CORE, rosbag play at 1x and the listener on core $PLAYER_CORE; outputs in $OUT)"

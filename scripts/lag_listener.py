@@ -6,9 +6,9 @@
 Until shut down (SIGINT), records
   - every map -> odom transform on /tf: lag = ROS time when it arrives (the /clock of rosbag play) - its stamp;
   - the SLAM's live pose (`pose`) and its last output path (`trajectory`);
-  - the last /diagnostics status of dpslam_node;
+  - dpslam_node's /diagnostics: the last status, and how many came at each level;
 then writes to DIR: lag.csv (stamp, lag), pose.tum, trajectory.tum and summary.json (lag median / p95 / max
-in s, transforms counted, the diagnostics' key/values).
+in s, transforms counted, the last diagnostics' key/values, the count of statuses per level).
 """
 import argparse
 import json
@@ -55,6 +55,7 @@ class Listener:
         self.poses = []  # (stamp, pose)
         self.path = None
         self.diagnostics = None
+        self.levels = {}  # diagnostic level (0 OK, 1 WARN, 2 ERROR) -> statuses received
         rospy.Subscriber("/tf", TFMessage, self.on_tf, queue_size=200)
         rospy.Subscriber("pose", PoseWithCovarianceStamped, self.on_pose, queue_size=200)
         rospy.Subscriber("trajectory", Path, self.on_path, queue_size=2)
@@ -78,6 +79,7 @@ class Listener:
             if "dpslam_node" in s.name:
                 self.diagnostics = {"name": s.name, "level": int(s.level), "message": s.message,
                                     "values": {kv.key: kv.value for kv in s.values}}
+                self.levels[int(s.level)] = self.levels.get(int(s.level), 0) + 1
 
     def write(self, out):
         os.makedirs(out, exist_ok=True)
@@ -100,6 +102,7 @@ class Listener:
             "poses": len(self.poses),
             "trajectory_poses": len(self.path.poses) if self.path else 0,
             "diagnostics": self.diagnostics,
+            "diagnostics_levels": self.levels,
         }
         with open(os.path.join(out, "summary.json"), "w") as f:
             json.dump(summary, f, indent=1)
