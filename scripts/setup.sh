@@ -12,9 +12,10 @@ export REPO WS
 DEB_PACKAGES=(
   build-essential cmake catkin ros-core-dev libroscpp-dev librosbag-dev
   libtf2-ros-dev libtf2-geometry-msgs-dev libtf2-msgs-dev libsensor-msgs-dev libnav-msgs-dev
-  libgeometry-msgs-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
+  libgeometry-msgs-dev libdiagnostic-updater-dev libdiagnostic-msgs-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
   python3-rosbag python3-rostest python3-rosunit python3-rospy python3-nose rosbash
   python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-tf2-msgs python3-tf2-ros tf2-tools
+  python3-diagnostic-msgs
   python3-numpy python3-matplotlib python3-yaml
   ros-message-generation ros-message-runtime python3-genmsg python3-gencpp python3-genpy
 )

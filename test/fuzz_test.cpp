@@ -9,9 +9,9 @@
 #include <limits>
 #include <random>
 
-#include "laser_dpslam/slam/dpslam.h"
 #include "laser_dpslam/odometry/laser_odometry.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
+#include "laser_dpslam/slam/dpslam.h"
 
 using namespace laser_dpslam;
 

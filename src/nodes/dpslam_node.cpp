@@ -3,8 +3,16 @@
 //
 // Odometry source: the TF odom→base_link at the scan's stamp (it works with laser_odometry_node, wheel
 // odometry or any other source, and laser_odometry_node stamps it with the very scan time). When the
-// `odom` topic carries a covariance for that stamp (laser_odometry_node does), it is used as the motion
-// noise; otherwise the motion model's parametric noise applies.
+// `odom` topic carries a covariance for that stamp (laser_odometry_node does), the motion noise is the
+// composition of the odometry messages' covariances since the previous scan used (motion_covariance.h);
+// otherwise the motion model's parametric noise applies.
+//
+// CPU: a worker thread processes the scans; the scan callback only leaves the newest scan for it
+// (newest_slot.h). While a step takes less than the scan period every scan is processed; when the CPU is
+// short, a scan that a newer one overtakes before the worker is free is skipped (counted), the next one
+// processed gets the odometry's whole motion since the last one, and map→odom lags the scan time by at most
+// about one step plus one period instead of falling behind through a queue of stale scans. Processing time,
+// that lag and the scans skipped go to /diagnostics (WARN while scans are skipped or the lag exceeds 1 s).
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/GetMap.h>
@@ -18,19 +26,28 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <deque>
+#include <diagnostic_updater/diagnostic_updater.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
 #include <memory>
 #include <mutex>
+#include <thread>
 
 #include "laser_dpslam/SaveMap.h"
-#include "laser_dpslam/slam/dpslam.h"
-#include "laser_dpslam/slam/dpslam_parameters.h"
+#include "laser_dpslam/common/newest_slot.h"
+#include "laser_dpslam/common/run_statistics.h"
 #include "laser_dpslam/export/occupancy_export.h"
 #include "laser_dpslam/ros/msg_conversion.h"
 #include "laser_dpslam/ros/names.h"
 #include "laser_dpslam/ros/ros_parameter_source.h"
 #include "laser_dpslam/ros/tf_wait.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
+#include "laser_dpslam/slam/dpslam.h"
+#include "laser_dpslam/slam/dpslam_parameters.h"
+#include "laser_dpslam/slam/motion_covariance.h"
+#include "laser_dpslam/slam/slam_load_monitor.h"
 #include "laser_dpslam/slam/trajectory_smoother.h"
 
 namespace laser_dpslam {
@@ -49,8 +66,28 @@ class DpSlamNode {
     odom_sub_ = nh.subscribe(names::kOdomTopic, 50, &DpSlamNode::onOdom, this);
     map_srv_ = nh.advertiseService(names::kDynamicMapService, &DpSlamNode::onGetMap, this);
     save_srv_ = nh.advertiseService(names::kSaveMapService, &DpSlamNode::onSaveMap, this);
+    updater_.setHardwareID("none");
+    updater_.add("scan processing", this, &DpSlamNode::diagnose);
+    // Wall time: the status keeps coming while a bag is paused or over (ROS time then stands still).
+    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(updater_.getPeriod()),
+                                            [this](const ros::WallTimerEvent&) { updater_.force_update(); });
     ROS_INFO("dpslam_node: %s -> %s from TF %s -> %s, %d particles", map_frame_.c_str(), odom_frame_.c_str(),
              odom_frame_.c_str(), base_frame_.c_str(), slam_config_.particles);
+    if (work_multiplier_ > 1.0) {
+      ROS_WARN("dpslam_node: work_multiplier %.2f: each scan's processing is stretched as on a CPU that much slower "
+               "(for benchmarks)", work_multiplier_);
+    }
+    worker_ = std::thread([this] { work(); });
+  }
+
+  ~DpSlamNode() {
+    slot_.close();
+    if (worker_.joinable()) worker_.join();
+    const SlotCounts c = slot_.counts();
+    if (c.skipped > 0) {
+      ROS_INFO("dpslam_node: %zu of %zu scans skipped (CPU short: a newer scan arrived before they were processed)",
+               c.skipped, c.offered);
+    }
   }
 
  private:
@@ -65,14 +102,45 @@ class DpSlamNode {
     map_update_interval_ = settings.map_update_interval;
     publish_particles_ = settings.publish_particles;
     transform_timeout_ = settings.transform_timeout;
+    work_multiplier_ = settings.work_multiplier;
     pre_config_ = settings.preprocessing;
     slam_config_ = settings.slam;
   }
 
   void onOdom(const nav_msgs::Odometry::ConstPtr& msg) {
-    // Keep the recent twist covariances by stamp: the motion noise of the scan with the same stamp.
-    odom_cov_.push_back(msg);
-    while (odom_cov_.size() > 50) odom_cov_.pop_front();
+    // Keep the recent messages: their twist covariances make the motion noise up to the scan with the same stamp.
+    const int idx[3] = {0, 1, 5};
+    Eigen::Matrix3d cov;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) cov(r, c) = msg->twist.covariance[idx[r] * 6 + idx[c]];
+    const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
+    {
+      std::lock_guard<std::mutex> lock(odom_mutex_);
+      if (stamp < odom_newest_ns_) odom_window_.clear();  // time went backwards: a new time line
+      odom_window_.add(stamp, poseFromMsg(msg->pose.pose), cov);
+      odom_newest_ns_ = stamp;
+    }
+    odom_arrived_.notify_all();
+  }
+
+  /// Covariance of the odometry's motion from the last scan used to the one at `stamp` (zero without
+  /// odometry messages carrying that stamp).
+  Eigen::Matrix3d motionCovariance(const ros::Time& stamp) {
+    const std::int64_t to = static_cast<std::int64_t>(stamp.toNSec());
+    std::unique_lock<std::mutex> lock(odom_mutex_);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    if (has_last_odom_) {
+      const std::int64_t from = static_cast<std::int64_t>(last_odom_stamp_.toNSec());
+      // laser_odometry_node sends a scan's odom message with its TF, which is here: when the messages kept
+      // up until the previous scan, this one's is at most a moment behind.
+      if (odom_newest_ns_ >= from && odom_newest_ns_ < to) {
+        odom_arrived_.wait_for(lock, std::chrono::duration<double>(transform_timeout_),
+                               [&] { return odom_newest_ns_ >= to || odom_newest_ns_ < from; });
+      }
+      cov = odom_window_.deltaCovariance(from, last_odom_, to);
+    }
+    odom_window_.dropUntil(to);
+    return cov;
   }
 
   bool lookup(const std::string& target, const std::string& source, const ros::Time& stamp,
@@ -87,36 +155,69 @@ class DpSlamNode {
     }
   }
 
+  // Spinner thread: only hands the scan over; a scan still waiting for the worker is replaced (skipped).
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg) {
-    const std::string laser_frame = cleanFrameId(msg->header.frame_id);
-    const ros::Time stamp = msg->header.stamp;
+    {
+      std::lock_guard<std::mutex> lock(load_mutex_);
+      load_.received(msg->header.stamp.toSec());
+    }
+    slot_.put(msg);
+  }
+
+  void work() {
+    sensor_msgs::LaserScan::ConstPtr msg;
+    while (slot_.take(&msg)) {
+      try {
+        processScan(*msg);
+      } catch (const std::exception& e) {
+        ROS_ERROR_THROTTLE(5.0, "dpslam_node: scan at %.3f not processed: %s", msg->header.stamp.toSec(), e.what());
+      }
+      msg.reset();
+    }
+  }
+
+  /// With work_multiplier > 1: burns (work_multiplier − 1) × the process CPU time used since cpu_start on
+  /// this thread, as a CPU that many times slower would have taken (the scoring threads' time included).
+  void stretch(double cpu_start) const {
+    if (work_multiplier_ <= 1.0) return;
+    const double extra = (work_multiplier_ - 1.0) * (processCpuSeconds() - cpu_start);
+    const double t0 = threadCpuSeconds();
+    while (threadCpuSeconds() - t0 < extra) {
+    }
+  }
+
+  void processScan(const sensor_msgs::LaserScan& scan) {
+    const ros::WallTime wall_start = ros::WallTime::now();
+    const double cpu_start = processCpuSeconds();
+    const std::string laser_frame = cleanFrameId(scan.header.frame_id);
+    const ros::Time stamp = scan.header.stamp;
     if (!last_stamp_.isZero() && stamp < last_stamp_) {
       ROS_WARN("dpslam_node: scan time went backwards (bag looped?): SLAM reset, the map starts over");
+      std::lock_guard<std::mutex> lock(mutex_);
       slam_->reset();
       has_last_odom_ = false;
       tf_buffer_.clear();
     }
-    last_stamp_ = stamp;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      last_stamp_ = stamp;
+    }
     geometry_msgs::TransformStamped mount_tf, odom_tf;
-    if (!lookup(base_frame_, laser_frame, ros::Time(0), &mount_tf, "the static laser mount")) return;
-    if (!lookup(odom_frame_, base_frame_, stamp, &odom_tf, "the odometry; is laser_odometry_node running?")) return;
+    if (!lookup(base_frame_, laser_frame, ros::Time(0), &mount_tf, "the static laser mount") ||
+        !lookup(odom_frame_, base_frame_, stamp, &odom_tf, "the odometry; is laser_odometry_node running?")) {
+      std::lock_guard<std::mutex> lock(load_mutex_);
+      load_.dropped();
+      return;
+    }
     const LaserMount mount = mountFromTransform(mount_tf.transform);
     const Pose2D odom = poseFromMsg(odom_tf.transform);
     const Pose2D delta = has_last_odom_ ? between(last_odom_, odom) : Pose2D();
-    Eigen::Matrix3d delta_cov = Eigen::Matrix3d::Zero();
-    const double dt = has_last_odom_ ? (stamp - last_odom_stamp_).toSec() : 0.0;
-    for (const auto& o : odom_cov_) {
-      if (o->header.stamp == stamp && dt > 0) {
-        const int idx[3] = {0, 1, 5};
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) delta_cov(r, c) = o->twist.covariance[idx[r] * 6 + idx[c]] * dt * dt;
-      }
-    }
+    const Eigen::Matrix3d delta_cov = motionCovariance(stamp);
     last_odom_ = odom;
     last_odom_stamp_ = stamp;
     has_last_odom_ = true;
 
-    const PreprocessedScan pre = preprocessScan(fromMsg(*msg), pre_config_);
+    const PreprocessedScan pre = preprocessScan(fromMsg(scan), pre_config_);
     if (!pre.ok()) ROS_WARN_THROTTLE(5.0, "dpslam_node: malformed scan: %s", pre.error.c_str());
     DpSlamUpdate u;
     {
@@ -126,11 +227,40 @@ class DpSlamNode {
     if (!u.ok) {
       ROS_WARN_THROTTLE(5.0, "dpslam_node: scan skipped (%s)", u.skip_reason.c_str());
     }
+    stretch(cpu_start);
     publishPose(stamp, u, odom);
+    const double published_at = ros::Time::now().toSec();
     if (last_map_stamp_.isZero() || (stamp - last_map_stamp_).toSec() >= map_update_interval_) {
+      const double cpu_map = processCpuSeconds();
       publishMap(stamp);
+      stretch(cpu_map);
       last_map_stamp_ = stamp;
     }
+    std::lock_guard<std::mutex> lock(load_mutex_);
+    load_.processed(stamp.toSec(), (ros::WallTime::now() - wall_start).toSec(), published_at);
+  }
+
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    SlamLoadReport r;
+    {
+      std::lock_guard<std::mutex> lock(load_mutex_);
+      r = load_.report(slot_.counts().skipped);
+    }
+    stat.summary(r.warn ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK, r.message);
+    stat.add("scans received", r.received);
+    stat.add("scans processed", r.processed);
+    stat.add("scans skipped", r.skipped);
+    stat.add("scans skipped since last report", r.skipped_recent);
+    stat.add("scans dropped (no transform)", r.dropped);
+    stat.addf("processing time last [s]", "%.4f", r.processing_s.last);
+    stat.addf("processing time mean [s]", "%.4f", r.processing_s.mean);
+    stat.addf("processing time max [s]", "%.4f", r.processing_s.max);
+    stat.addf("map->odom lag last [s]", "%.4f", r.lag_s.last);
+    stat.addf("map->odom lag mean [s]", "%.4f", r.lag_s.mean);
+    stat.addf("map->odom lag max [s]", "%.4f", r.lag_s.max);
+    stat.addf("map->odom lag max since last report [s]", "%.4f", r.lag_recent_max_s);
+    stat.addf("newest scan ahead of map->odom [s]", "%.4f", r.backlog_s);
+    if (work_multiplier_ > 1.0) stat.addf("work multiplier", "%.2f", work_multiplier_);
   }
 
   void publishPose(const ros::Time& stamp, const DpSlamUpdate& u, const Pose2D& odom) {
@@ -206,7 +336,12 @@ class DpSlamNode {
   }
 
   bool onGetMap(nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& res) {
-    res.map = gridMsg(last_stamp_);
+    ros::Time stamp;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stamp = last_stamp_;
+    }
+    res.map = gridMsg(stamp);
     return true;
   }
 
@@ -235,24 +370,37 @@ class DpSlamNode {
   }
 
   std::string map_frame_, odom_frame_, base_frame_;
-  double map_update_interval_ = 2.0, transform_timeout_ = 0.2;
+  double map_update_interval_ = 2.0, transform_timeout_ = 0.2, work_multiplier_ = 1.0;
   bool publish_particles_ = true;
   DpSlamConfig slam_config_;
   ScanPreprocessorConfig pre_config_;
 
   std::unique_ptr<DpSlam> slam_;
-  std::mutex mutex_;
+  std::mutex mutex_;  ///< slam_ and last_stamp_ (the worker writes them, services read them)
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::Publisher map_pub_, metadata_pub_, pose_pub_, path_pub_, particles_pub_;
   ros::Subscriber scan_sub_, odom_sub_;
   ros::ServiceServer map_srv_, save_srv_;
-  std::deque<nav_msgs::Odometry::ConstPtr> odom_cov_;
+  ros::WallTimer diagnostics_timer_;
+  diagnostic_updater::Updater updater_;
+
+  std::mutex odom_mutex_;  ///< odom_window_, odom_newest_ns_ (the spinner writes them, the worker reads them)
+  std::condition_variable odom_arrived_;
+  MotionCovarianceWindow odom_window_;
+  std::int64_t odom_newest_ns_ = 0;
+
+  std::mutex load_mutex_;  ///< load_
+  SlamLoadMonitor load_;
+  NewestSlot<sensor_msgs::LaserScan::ConstPtr> slot_;
+
+  // The worker's own.
   Pose2D last_odom_;
   ros::Time last_odom_stamp_, last_stamp_, last_map_stamp_;
   bool has_last_odom_ = false;
   nav_msgs::OccupancyGrid last_map_;
+  std::thread worker_;  ///< last: started when everything else exists
 };
 
 }  // namespace laser_dpslam

@@ -9,13 +9,13 @@
 
 #include <memory>
 
+#include "laser_dpslam/common/run_statistics.h"
 #include "laser_dpslam/odometry/laser_odometry.h"
 #include "laser_dpslam/odometry/odometry_parameters.h"
 #include "laser_dpslam/ros/msg_conversion.h"
 #include "laser_dpslam/ros/names.h"
 #include "laser_dpslam/ros/ros_parameter_source.h"
 #include "laser_dpslam/ros/tf_wait.h"
-#include "laser_dpslam/common/run_statistics.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
 
 namespace laser_dpslam {

@@ -21,19 +21,19 @@
 #include <sys/stat.h>
 #include <vector>
 
-#include "laser_dpslam/slam/dpslam.h"
-#include "laser_dpslam/slam/dpslam_parameters.h"
-#include "laser_dpslam/odometry/laser_odometry.h"
-#include "laser_dpslam/export/occupancy_export.h"
-#include "laser_dpslam/odometry/odometry_parameters.h"
 #include "laser_dpslam/common/parameter_source.h"
+#include "laser_dpslam/common/run_statistics.h"
+#include "laser_dpslam/common/trajectory_io.h"
+#include "laser_dpslam/export/occupancy_export.h"
+#include "laser_dpslam/odometry/laser_odometry.h"
+#include "laser_dpslam/odometry/odometry_parameters.h"
+#include "laser_dpslam/offline/trajectory_refiner.h"
 #include "laser_dpslam/ros/bag_scan_reader.h"
 #include "laser_dpslam/ros/bag_tf.h"
 #include "laser_dpslam/ros/msg_conversion.h"
-#include "laser_dpslam/common/run_statistics.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
-#include "laser_dpslam/common/trajectory_io.h"
-#include "laser_dpslam/offline/trajectory_refiner.h"
+#include "laser_dpslam/slam/dpslam.h"
+#include "laser_dpslam/slam/dpslam_parameters.h"
 
 using namespace laser_dpslam;
 

@@ -27,8 +27,8 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/sim/floor_plan.h"
 #include "laser_dpslam/ros/msg_conversion.h"
+#include "laser_dpslam/sim/floor_plan.h"
 #include "laser_dpslam/sim/scan_simulator.h"
 #include "laser_dpslam/sim/sim_path.h"
 #include "laser_dpslam/sim/vector_plan.h"

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/slam/dpslam_parameters.h"
-#include "laser_dpslam/odometry/odometry_parameters.h"
 #include "laser_dpslam/common/parameter_docs.h"
+#include "laser_dpslam/odometry/odometry_parameters.h"
+#include "laser_dpslam/slam/dpslam_parameters.h"
 
 using namespace laser_dpslam;
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/slam/dpslam_parameters.h"
 #include "laser_dpslam/odometry/odometry_parameters.h"
+#include "laser_dpslam/slam/dpslam_parameters.h"
 
 using namespace laser_dpslam;
 

@@ -10,12 +10,12 @@
 #include <random>
 #include <string>
 
-#include "laser_dpslam/sim/floor_plan.h"
 #include "laser_dpslam/odometry/laser_odometry.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
 #include "laser_dpslam/scan/scan_resampler.h"
-#include "laser_dpslam/sim/scan_simulator.h"
 #include "laser_dpslam/scan/voxel_filter.h"
+#include "laser_dpslam/sim/floor_plan.h"
+#include "laser_dpslam/sim/scan_simulator.h"
 #include "test_rooms.h"
 
 using namespace laser_dpslam;

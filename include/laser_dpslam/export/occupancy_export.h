@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "laser_dpslam/common/trajectory_io.h"
 #include "laser_dpslam/slam/ancestry_tree.h"
 #include "laser_dpslam/slam/dpslam_map.h"
-#include "laser_dpslam/common/trajectory_io.h"
 
 namespace laser_dpslam {
 

@@ -6,8 +6,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "laser_dpslam/matching/ndt_grid.h"
 #include "laser_dpslam/common/pose2d.h"
+#include "laser_dpslam/matching/ndt_grid.h"
 
 namespace laser_dpslam {
 

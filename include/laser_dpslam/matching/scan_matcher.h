@@ -9,10 +9,10 @@
 #include <random>
 #include <vector>
 
+#include "laser_dpslam/common/pose2d.h"
 #include "laser_dpslam/matching/differential_evolution.h"
 #include "laser_dpslam/matching/ndt_grid.h"
 #include "laser_dpslam/matching/ndt_score_raster.h"
-#include "laser_dpslam/common/pose2d.h"
 
 namespace laser_dpslam {
 

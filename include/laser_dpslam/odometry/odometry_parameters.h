@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/odometry/laser_odometry.h"
 #include "laser_dpslam/common/parameter_registry.h"
 #include "laser_dpslam/common/parameter_source.h"
+#include "laser_dpslam/odometry/laser_odometry.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
 
 namespace laser_dpslam {

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "laser_dpslam/common/pose2d.h"
-#include "laser_dpslam/offline/pose_graph.h"
-#include "laser_dpslam/matching/scan_matcher.h"
 #include "laser_dpslam/common/trajectory_io.h"
+#include "laser_dpslam/matching/scan_matcher.h"
+#include "laser_dpslam/offline/pose_graph.h"
 
 namespace laser_dpslam {
 

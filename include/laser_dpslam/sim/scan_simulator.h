@@ -6,9 +6,9 @@
 #include <random>
 #include <string>
 
-#include "laser_dpslam/sim/floor_plan.h"
 #include "laser_dpslam/common/laser_scan.h"
 #include "laser_dpslam/common/pose2d.h"
+#include "laser_dpslam/sim/floor_plan.h"
 #include "laser_dpslam/sim/vector_plan.h"
 
 namespace laser_dpslam {

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/sim/floor_plan.h"
 #include "laser_dpslam/common/pose2d.h"
+#include "laser_dpslam/sim/floor_plan.h"
 
 namespace laser_dpslam {
 

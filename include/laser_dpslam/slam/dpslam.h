@@ -12,16 +12,16 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/slam/ancestry_tree.h"
-#include "laser_dpslam/slam/dpslam_map.h"
 #include "laser_dpslam/common/laser_mount.h"
-#include "laser_dpslam/export/occupancy_export.h"
-#include "laser_dpslam/slam/particle_filter.h"
 #include "laser_dpslam/common/pose2d.h"
-#include "laser_dpslam/slam/revisit_detector.h"
+#include "laser_dpslam/common/trajectory_io.h"
+#include "laser_dpslam/export/occupancy_export.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
 #include "laser_dpslam/scan/surface_incidence.h"
-#include "laser_dpslam/common/trajectory_io.h"
+#include "laser_dpslam/slam/ancestry_tree.h"
+#include "laser_dpslam/slam/dpslam_map.h"
+#include "laser_dpslam/slam/particle_filter.h"
+#include "laser_dpslam/slam/revisit_detector.h"
 
 namespace laser_dpslam {
 

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "laser_dpslam/slam/dpslam.h"
 #include "laser_dpslam/common/parameter_registry.h"
 #include "laser_dpslam/common/parameter_source.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
+#include "laser_dpslam/slam/dpslam.h"
 
 namespace laser_dpslam {
 
@@ -21,6 +21,9 @@ struct DpSlamNodeSettings {
   double map_update_interval = 2.0;  ///< s of data time
   bool publish_particles = true;
   double transform_timeout = 0.2;  ///< s
+  /// Benchmarks only: after each scan the node busy-waits (this − 1) × that scan's processing CPU time,
+  /// as a CPU this many times slower would take (scripts/benchmark_lag.sh). 1 = off.
+  double work_multiplier = 1.0;
   ScanPreprocessorConfig preprocessing;  ///< only min_range and max_range are parameters
   DpSlamConfig slam;
 };

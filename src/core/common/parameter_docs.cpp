@@ -2,8 +2,8 @@
 
 #include <vector>
 
-#include "laser_dpslam/slam/dpslam_parameters.h"
 #include "laser_dpslam/odometry/odometry_parameters.h"
+#include "laser_dpslam/slam/dpslam_parameters.h"
 
 namespace laser_dpslam {
 

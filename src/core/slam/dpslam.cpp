@@ -4,9 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "laser_dpslam/slam/trajectory_smoother.h"
-#include "laser_dpslam/scan/wall_direction.h"
 #include "laser_dpslam/common/worker_pool.h"
+#include "laser_dpslam/scan/wall_direction.h"
+#include "laser_dpslam/slam/trajectory_smoother.h"
 
 namespace laser_dpslam {
 

@@ -185,6 +185,11 @@ std::vector<Parameter<S>> observationAndOutputEntries() {
        "node are not changed by it. Costs ~10 MB per 180 m and a few seconds at the end (loop building 177 m: 7 s; "
        "CSAIL: 4 s); false = no refinement",
        kAdvanced},
+      {"work_multiplier", "output and execution", FIELD(work_multiplier), "-", atLeast(1),
+       "dpslam_node only, to benchmark a slower CPU: after each scan the node busy-waits (this - 1) x the CPU "
+       "time that scan's processing took, as a CPU this many times slower would (scripts/benchmark_lag.sh); "
+       "1 = off. Not for normal use",
+       kAdvanced},
   };
 }
 

@@ -1,0 +1,67 @@
+#include "laser_dpslam/slam/motion_covariance.h"
+
+#include <cmath>
+
+namespace laser_dpslam {
+
+namespace {
+/// Seconds of a duration in ns, converted as a ROS duration converts itself (whole seconds + 1e-9 × the
+/// nanoseconds left), so that one interval gives the same dt as the node computed from its stamps.
+double seconds(std::int64_t ns) {
+  std::int64_t sec = ns / 1000000000;
+  std::int64_t nsec = ns % 1000000000;
+  if (nsec < 0) {
+    nsec += 1000000000;
+    --sec;
+  }
+  return static_cast<double>(sec) + 1e-9 * static_cast<double>(nsec);
+}
+}  // namespace
+
+bool MotionCovarianceWindow::add(std::int64_t stamp_ns, const Pose2D& pose, const Eigen::Matrix3d& velocity_cov) {
+  if (!samples_.empty() && stamp_ns <= samples_.back().stamp_ns) return false;
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta) || !velocity_cov.allFinite()) {
+    return false;
+  }
+  samples_.push_back({stamp_ns, pose, velocity_cov});
+  while (samples_.size() > capacity_) samples_.pop_front();
+  return true;
+}
+
+Eigen::Matrix3d MotionCovarianceWindow::deltaCovariance(std::int64_t from_ns, const Pose2D& from_pose,
+                                                        std::int64_t to_ns) const {
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  if (to_ns <= from_ns) return cov;
+  bool have_end = false;
+  for (const Sample& s : samples_) have_end = have_end || s.stamp_ns == to_ns;
+  if (!have_end) return cov;
+  Pose2D motion;  // composed since from_pose
+  Pose2D previous_pose = from_pose;
+  std::int64_t previous_ns = from_ns;
+  bool first = true;
+  for (const Sample& s : samples_) {
+    if (s.stamp_ns <= from_ns) continue;
+    if (s.stamp_ns > to_ns) break;
+    const double dt = seconds(s.stamp_ns - previous_ns);
+    const Eigen::Matrix3d step = s.velocity_cov * dt * dt;
+    const Pose2D delta = between(previous_pose, s.pose);
+    if (first) {
+      cov = step;
+    } else {
+      Eigen::Matrix3d ja, jb;
+      composeJacobians(motion, delta, &ja, &jb);
+      cov = ja * cov * ja.transpose() + jb * step * jb.transpose();
+    }
+    motion = motion * delta;
+    previous_pose = s.pose;
+    previous_ns = s.stamp_ns;
+    first = false;
+  }
+  return cov;
+}
+
+void MotionCovarianceWindow::dropUntil(std::int64_t stamp_ns) {
+  while (!samples_.empty() && samples_.front().stamp_ns <= stamp_ns) samples_.pop_front();
+}
+
+}  // namespace laser_dpslam
