@@ -45,9 +45,7 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(m.use_de, dm.use_de);
   EXPECT_EQ(m.de_population, dm.de_population);
   EXPECT_EQ(m.de_generations, dm.de_generations);
-  EXPECT_EQ(m.de_F, dm.de_F);
   EXPECT_EQ(m.de_CR, dm.de_CR);
-  EXPECT_EQ(m.de_dither, dm.de_dither);
   EXPECT_EQ(m.window_xy, dm.window_xy);
   EXPECT_EQ(m.window_theta, dm.window_theta);
   EXPECT_EQ(m.de_spread_xy, dm.de_spread_xy);
@@ -92,7 +90,6 @@ TEST(OdometryParameters, ValuesAreReadAndBadOnesNamed) {
     return std::string("no error");
   };
   EXPECT_NE(message("de_population: 3").find("de_population"), std::string::npos);
-  EXPECT_NE(message("de_F: fast").find("de_F"), std::string::npos);
   EXPECT_NE(message("resampling: random").find("saliency"), std::string::npos);
   EXPECT_NE(message("ndt_cell_sizes: [1.0, -0.5]").find("ndt_cell_sizes"), std::string::npos);
   EXPECT_NE(message("de_CR: 1.5").find("de_CR"), std::string::npos);

@@ -632,11 +632,12 @@ TEST(DpSlamMap, ObservationModelValues) {
               map.beamLogLikelihood(beam(1.0), 20.0, 0, cache, m), 1e-9);
 }
 
-// The edge of what a range-limited laser has mapped pulls the filter back (DpSlamConfig::score_range_margin):
-// a side wall written from A (a laser with range_max 5.6 m) is known only up to x ≈ 5.51 m; from B, 0.2 m
-// further, a return just past that edge scores better the further back B is assumed, because the stop it
-// needs lies on cells only a pose behind has seen. Scored as free space up to a range short of the edge
-// (max_range 5.3 m), every pose is equal.
+// The edge of what a range-limited laser has mapped pulls the filter back: a side wall written from A (a
+// laser with range_max 5.6 m) is known only up to x ≈ 5.51 m; from B, 0.2 m further, a return just past that
+// edge scores better the further back B is assumed, because the stop it needs lies on cells only a pose
+// behind has seen. Scored as free space up to a range short of the edge (max_range 5.3 m), every pose is
+// equal. (A map property the SLAM lives with: cutting the scored range this way brought no gain with the
+// laser odometry, doc/experiments.md.)
 TEST(DpSlamMap, ReturnsPastTheMappedEdgeFavourPosesBehindUnlessCutShort) {
   AncestryTree tree;
   DpSlamMap map(0.05, 4.0);

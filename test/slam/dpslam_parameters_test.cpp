@@ -17,10 +17,6 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.particles, d.particles);
   EXPECT_EQ(c.oversampling, d.oversampling);
   EXPECT_EQ(c.cull_window, d.cull_window);
-  EXPECT_EQ(c.refine_iterations, d.refine_iterations);
-  EXPECT_EQ(c.refine_step_xy, d.refine_step_xy);
-  EXPECT_EQ(c.refine_step_theta, d.refine_step_theta);
-  EXPECT_EQ(c.refine_halvings, d.refine_halvings);
   EXPECT_EQ(c.resample_threshold, d.resample_threshold);
   EXPECT_EQ(c.proposal.covariance_scale, d.proposal.covariance_scale);
   EXPECT_EQ(c.proposal.min_sigma_xy, d.proposal.min_sigma_xy);
@@ -45,7 +41,6 @@ TEST(DpSlamParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(c.surface_min_cos, d.surface_min_cos);
   EXPECT_EQ(c.cell_normal_min_cos, d.cell_normal_min_cos);
   EXPECT_EQ(c.cell_surface_offsets, d.cell_surface_offsets);
-  EXPECT_EQ(c.score_range_margin, d.score_range_margin);
   EXPECT_EQ(c.beam.sigma, d.beam.sigma);
   EXPECT_EQ(c.beam.window, d.beam.window);
   EXPECT_EQ(c.beam.log_floor, d.beam.log_floor);
@@ -88,7 +83,6 @@ TEST(DpSlamParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("threads: 0").find("threads"), std::string::npos);
   EXPECT_NE(message("surface_depth: -1").find("surface_depth"), std::string::npos);
   EXPECT_NE(message("surface_min_cos: 0").find("surface_min_cos"), std::string::npos);
-  EXPECT_NE(message("score_range_margin: -0.1").find("score_range_margin"), std::string::npos);
   EXPECT_NE(message("trajectory_smoothing: -1").find("trajectory_smoothing"), std::string::npos);
   EXPECT_NE(message("surface_min_cos: 1.5").find("surface_min_cos"), std::string::npos);
   EXPECT_NE(message("cell_normal_min_cos: 1.5").find("cell_normal_min_cos"), std::string::npos);

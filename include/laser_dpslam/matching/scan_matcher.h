@@ -25,9 +25,7 @@ struct ScanMatcherConfig {
   bool use_de = true;                 ///< false: Newton from the prior only (for comparison)
   int de_population = 20;             ///< NP
   int de_generations = 30;            ///< G, upper bound
-  double de_F = 0.6;                  ///< scale factor
   double de_CR = 0.9;                 ///< crossover rate
-  bool de_dither = true;              ///< F ~ U(0.5, 1) per generation
   double window_xy = 0.3;             ///< m, half-width of the search window around the prior
   double window_theta = 0.26;         ///< rad, half-width of the search window (≈ 15°)
   double de_spread_xy = 0.01;         ///< m, stop when the population spread is below this …

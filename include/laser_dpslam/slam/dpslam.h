@@ -34,10 +34,6 @@ struct DpSlamConfig {
   int oversampling = 4;             ///< candidate poses drawn per particle; the best by the cheap score is kept (1 = off; doc/benchmarks.md: 4 closes every loop-building seed)
   double cull_window = 0.25;        ///< m, half-width around each measured range traced by the cheap score
   double resample_threshold = 0.5;  ///< resample when Neff < this × P (1 = every update)
-  int refine_iterations = 0;        ///< improved proposal: hill-climbing steps of each particle on its own map (0 = off)
-  double refine_step_xy = 0.02;     ///< m, first step of the hill climb
-  double refine_step_theta = 0.005; ///< rad, first step of the hill climb
-  int refine_halvings = 3;          ///< the climb stops after halving its steps this many times
   ProposalNoise proposal;           ///< noise added to the scan-match delta (see ProposalNoise)
   /// Multiplies the proposal noise while the robot explores (no path of the best particle from at least
   /// revisit_min_travel ago within revisit_radius): there the particles' own maps cannot tell their spread
@@ -78,13 +74,6 @@ struct DpSlamConfig {
   /// stop there is scored at the beam's crossing of that line, not the middle of the cell (DpSlamMap::setSurfaceOffsets)
   bool cell_surface_offsets = true;
   // --- Observation model ---
-  /// m; returns within this of the scan's range_max are scored as free space up to range_max − this: the
-  /// walls around them were written from poses behind, whose range ended short of them, and a stop wanted
-  /// on cells only a pose behind has seen pulls the filter back (maps too short). 0 = off; applies to scans
-  /// whose range_max exceeds twice this.
-  double score_range_margin = 0.0;
-  /// m; how far beams of a scan with this range_max (0 = unknown) are traced and scored as returns.
-  double scoreRange(double scan_range_max) const;
   BeamModelConfig beam;         ///< sigma, window, log floor, unknown mean free path
   int score_beam_step = 4;      ///< every k-th beam is scored (tempering and speed)
   double likelihood_weight = 0.5;  ///< exponent of a scan's likelihood in the weights (tempering, 0–1]
@@ -177,7 +166,6 @@ class DpSlam {
   void makeBeams(const PreprocessedScan& scan, const LaserMount& mount);
   MapBeam toMap(const PoseFrame& f, const BaseBeam& b) const;
   double score(const Pose2D& pose, int slot, LookupCache& cache) const;
-  double cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const;
   /// Calls f(i, beam, cache) for every item i < n and every beam of `beams`, beam by beam over a block of
   /// items (all of them on one thread, else a few blocks per worker): particles close together trace
   /// nearly the same cells, so the map memory one beam touches stays in the CPU cache from one particle to
@@ -188,8 +176,6 @@ class DpSlam {
   void scoreAll(const std::vector<Pose2D>& chosen, std::vector<double>& ll);
   /// Fills cheap[n] with cheapScore(candidates[n], slot n / per_slot), beam-major.
   void cheapScoreAll(const std::vector<Pose2D>& candidates, int per_slot, std::vector<double>& cheap);
-  /// Hill climb of the cheap score from `start` (steps along the particle's own axes).
-  Pose2D refine(const Pose2D& start, int slot, LookupCache& cache) const;
   /// Plans the scan writes of `who` (old particles, at `at`, seen through the scoring caches) in parallel.
   void planWrites(const std::vector<int>& who, const std::vector<Pose2D>& at);
   /// Applies the planned writes of who[s] under nodes[s] (single-threaded, in order).
@@ -198,9 +184,6 @@ class DpSlam {
   /// Steps 1-3 of filterStep: every particle's new pose into chosen, its log-likelihood there into ll.
   void propose(const Pose2D& delta, const Eigen::Matrix3d& cov, std::vector<Pose2D>& chosen,
                std::vector<double>& ll);
-  /// The improved proposal (refine_iterations > 0); L the proposal noise's factor.
-  void proposeRefined(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
-                      std::vector<double>& ll);
   /// Sampled candidates, the best of `oversampling` per particle by the cheap score, then scored.
   void proposeSampled(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
                       std::vector<double>& ll);
@@ -237,7 +220,7 @@ class DpSlam {
   bool force_map_update_ = false;
 
   Eigen::Vector2d beam_origin_ = Eigen::Vector2d::Zero();  ///< laser position in the base frame
-  double score_range_ = 20.0;  ///< m, DpSlamConfig::scoreRange of the current scan
+
   std::vector<BaseBeam> score_beams_, update_beams_;
   RevisitDetector revisit_;      ///< on the best particle's path: exploring or revisiting
   bool last_revisit_ = false;

@@ -158,9 +158,9 @@ Pose2D ScanMatcher::deSearch(const MatchInput& in, const Eigen::Vector3d& w, std
   DE::Config dc;
   dc.population = config_.de_population;
   dc.max_generations = config_.de_generations;
-  dc.F = config_.de_F;
   dc.CR = config_.de_CR;
-  dc.dither = config_.de_dither;
+  // The scale factor drawn from U(0.5, 1) per generation (dither, Das et al. 2005): no fixed F to tune.
+  dc.dither = true;
   dc.strategy = DE::Strategy::kRand1Bin;
   dc.spread_tolerance = Eigen::Vector3d(config_.de_spread_xy, config_.de_spread_xy, config_.de_spread_theta);
   dc.stall_generations = config_.de_stall_generations;

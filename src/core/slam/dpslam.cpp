@@ -38,8 +38,6 @@ void DpSlamConfig::validate() const {
   require(particles >= 1 && particles <= 10000, "particles must be in [1, 10000]");
   require(oversampling >= 1, "oversampling must be >= 1");
   require(cull_window > 0.0, "cull_window must be > 0");
-  require(refine_iterations >= 0 && refine_halvings >= 0, "refine_iterations and refine_halvings must be >= 0");
-  require(refine_step_xy > 0.0 && refine_step_theta > 0.0, "refine steps must be > 0");
   require(resample_threshold >= 0.0 && resample_threshold <= 1.0, "resample_threshold must be in [0, 1]");
   require(proposal.covariance_scale >= 0.0, "proposal_covariance_scale must be >= 0");
   require(proposal.min_sigma_xy >= 0.0 && proposal.min_sigma_theta >= 0.0, "proposal minimum sigmas must be >= 0");
@@ -58,7 +56,6 @@ void DpSlamConfig::validate() const {
   require(surface_depth >= 0.0, "surface_depth must be >= 0");
   require(surface_min_cos > 0.0 && surface_min_cos <= 1.0, "surface_min_cos must be in (0, 1]");
   require(cell_normal_min_cos >= 0.0 && cell_normal_min_cos <= 1.0, "cell_normal_min_cos must be in [0, 1]");
-  require(score_range_margin >= 0.0, "score_range_margin must be >= 0");
   require(map_update_distance >= 0.0 && map_update_angle >= 0.0, "map update thresholds must be >= 0");
   require(beam.sigma > 0.0, "beam_sigma must be > 0");
   require(likelihood_weight > 0.0 && likelihood_weight <= 1.0, "likelihood_weight must be in (0, 1]");
@@ -69,12 +66,6 @@ void DpSlamConfig::validate() const {
   require(occupancy_stop_length > 0.0, "occupancy_stop_length must be > 0");
   require(trajectory_smoothing >= 0.0 && std::isfinite(trajectory_smoothing), "trajectory_smoothing must be >= 0");
   require(threads >= 1, "threads must be >= 1");
-}
-
-double DpSlamConfig::scoreRange(double scan_range_max) const {
-  if (score_range_margin > 0.0 && scan_range_max > 2.0 * score_range_margin)
-    return std::min(trace_max_range, scan_range_max - score_range_margin);
-  return trace_max_range;
 }
 
 DpSlam::DpSlam(const DpSlamConfig& config)
@@ -116,7 +107,6 @@ void DpSlam::reset() {
 
 void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
   beam_origin_ = mount.t;
-  score_range_ = config_.scoreRange(scan.range_max);
   const double no_return_range = std::min(config_.no_return_range, scan.range_max > 0.0 ? scan.range_max : config_.no_return_range);
   std::vector<BaseBeam> all;
   all.reserve(scan.points.size() + scan.no_return_angles.size());
@@ -181,17 +171,7 @@ double DpSlam::score(const Pose2D& pose, int slot, LookupCache& cache) const {
   const PoseFrame f(pose);
   double sum = 0.0;
   for (const BaseBeam& b : score_beams_) {
-    sum += map_.beamLogLikelihood(toMap(f, b), score_range_, slot, cache, config_.beam);
-  }
-  return sum;
-}
-
-double DpSlam::cheapScore(const Pose2D& pose, int slot, LookupCache& cache) const {
-  const PoseFrame f(pose);
-  double sum = 0.0;
-  for (const BaseBeam& b : score_beams_) {
-    if (b.no_return || b.range >= score_range_) continue;
-    sum += map_.beamEndpointLogLikelihood(toMap(f, b), config_.cull_window, slot, cache, config_.beam);
+    sum += map_.beamLogLikelihood(toMap(f, b), config_.trace_max_range, slot, cache, config_.beam);
   }
   return sum;
 }
@@ -215,7 +195,7 @@ void DpSlam::scoreAll(const std::vector<Pose2D>& chosen, std::vector<double>& ll
   std::vector<PoseFrame> frames(chosen.begin(), chosen.end());
   std::fill(ll.begin(), ll.end(), 0.0);
   forEachBeamByBlock(chosen.size(), score_beams_, [&](std::size_t i, const BaseBeam& b, LookupCache& cache) {
-    ll[i] += map_.beamLogLikelihood(toMap(frames[i], b), score_range_, static_cast<int>(i), cache, config_.beam);
+    ll[i] += map_.beamLogLikelihood(toMap(frames[i], b), config_.trace_max_range, static_cast<int>(i), cache, config_.beam);
   });
 }
 
@@ -223,40 +203,10 @@ void DpSlam::cheapScoreAll(const std::vector<Pose2D>& candidates, int per_slot, 
   std::vector<PoseFrame> frames(candidates.begin(), candidates.end());
   std::fill(cheap.begin(), cheap.end(), 0.0);
   forEachBeamByBlock(candidates.size(), score_beams_, [&](std::size_t n, const BaseBeam& b, LookupCache& cache) {
-    if (b.no_return || b.range >= score_range_) return;
+    if (b.no_return || b.range >= config_.trace_max_range) return;
     cheap[n] += map_.beamEndpointLogLikelihood(toMap(frames[n], b), config_.cull_window, static_cast<int>(n) / per_slot,
                                                cache, config_.beam);
   });
-}
-
-Pose2D DpSlam::refine(const Pose2D& start, int slot, LookupCache& cache) const {
-  Pose2D x = start;
-  double best = cheapScore(x, slot, cache);
-  double sxy = config_.refine_step_xy, sth = config_.refine_step_theta;
-  int halvings = 0;
-  for (int it = 0; it < config_.refine_iterations; ++it) {
-    const Pose2D moves[6] = {Pose2D(sxy, 0, 0), Pose2D(-sxy, 0, 0), Pose2D(0, sxy, 0),
-                             Pose2D(0, -sxy, 0), Pose2D(0, 0, sth),  Pose2D(0, 0, -sth)};
-    Pose2D bx = x;
-    bool improved = false;
-    for (const Pose2D& m : moves) {
-      const Pose2D c = x * m;
-      const double v = cheapScore(c, slot, cache);
-      if (v > best) {
-        best = v;
-        bx = c;
-        improved = true;
-      }
-    }
-    if (improved) {
-      x = bx;
-    } else {
-      if (++halvings > config_.refine_halvings) break;
-      sxy *= 0.5;
-      sth *= 0.5;
-    }
-  }
-  return x;
 }
 
 void DpSlam::planWrites(const std::vector<int>& who, const std::vector<Pose2D>& at) {
@@ -394,26 +344,7 @@ void DpSlam::propose(const Pose2D& delta, const Eigen::Matrix3d& cov, std::vecto
   last_revisit_ = revisit_.update(Eigen::Vector2d(ahead.x, ahead.y), std::hypot(delta.x, delta.y));
   if (!last_revisit_) L *= config_.explore_noise_scale;
   for (auto& c : caches_) c.begin(tree_, leaves_);
-  if (config_.refine_iterations > 0) {
-    proposeRefined(delta, L, chosen, ll);
-  } else {
-    proposeSampled(delta, L, chosen, ll);
-  }
-}
-
-void DpSlam::proposeRefined(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
-                            std::vector<double>& ll) {
-  // Improved proposal: each particle climbs to the best fit of the scan on its own map from pose ⊕ delta,
-  // is weighted there (so the noise below does not make the weights peaky), and then moves by noise
-  // drawn from the proposal's covariance around that fit.
-  const int P = config_.particles;
-  std::vector<Pose2D> noise(P);
-  for (int i = 0; i < P; ++i) noise[i] = sampleMotion(Pose2D(), L, rng_);
-  pool_->run(P, [&](std::size_t i, int w) {
-    const Pose2D fit = refine(poses_[i] * delta, static_cast<int>(i), caches_[w]);
-    ll[i] = score(fit, static_cast<int>(i), caches_[w]);
-    chosen[i] = fit * noise[i];
-  });
+  proposeSampled(delta, L, chosen, ll);
 }
 
 void DpSlam::proposeSampled(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,

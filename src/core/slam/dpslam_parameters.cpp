@@ -55,15 +55,6 @@ std::vector<Parameter<S>> filterEntries() {
        "... or turned this much (each 0 = off; both 0 = at every scan)", kUser},
       {"cull_window", "particle filter", FIELD(slam.cull_window), "m", above(0),
        "half-width around each measured range traced by the cheap (culling) score", kAdvanced},
-      {"refine_iterations", "particle filter", FIELD(slam.refine_iterations), "steps", atLeast(0),
-       "improved proposal: hill-climbing steps of each particle on its own map by the cheap score; 0 = off",
-       kAdvanced},
-      {"refine_step_xy", "particle filter", FIELD(slam.refine_step_xy), "m", above(0),
-       "first translation step of that hill climb", kAdvanced},
-      {"refine_step_theta", "particle filter", FIELD(slam.refine_step_theta), "rad", above(0),
-       "first rotation step of that hill climb", kAdvanced},
-      {"refine_halvings", "particle filter", FIELD(slam.refine_halvings), "-", atLeast(0),
-       "the climb stops after halving its steps this many times", kAdvanced},
       {"resample_threshold", "particle filter", FIELD(slam.resample_threshold), "-", closedInterval(0, 1),
        "resample when Neff < this x P (1 = at every update)", kAdvanced},
       {"proposal_covariance_scale", "particle filter", FIELD(slam.proposal.covariance_scale), "-", atLeast(0),
@@ -157,11 +148,6 @@ std::vector<Parameter<S>> observationAndOutputEntries() {
        "every k-th beam is scored (tempering and speed)", kAdvanced},
       {"likelihood_weight", "observation model", FIELD(slam.likelihood_weight), "-", leftOpenInterval(0, 1),
        "exponent of a scan's likelihood in the particle weights (tempering)", kAdvanced},
-      {"score_range_margin", "observation model", FIELD(slam.score_range_margin), "m", atLeast(0),
-       "returns within this of the scan's range_max are scored as free space up to range_max - this: the walls "
-       "around them lie at the edge of what earlier poses mapped, and scoring them there pulls the filter back; "
-       "0 = off (applies when range_max > 2 x this)",
-       kAdvanced},
       {"score_no_return", "observation model", FIELD(slam.score_no_return), "bool", anyValue(),
        "no-return beams are scored (free space up to no_return_range)", kAdvanced},
 
