@@ -107,7 +107,7 @@ class SlamRostest(unittest.TestCase):
             for line in f:
                 v = [float(x) for x in line.split()]
                 truth.append((v[0], v[1], v[2], 2.0 * math.atan2(v[6], v[7])))
-        # The map frame is the SLAM's own (the first pose, turned to the walls with map_align_to_walls):
+        # The map frame is the SLAM's own (the first pose, turned to the walls with align_to_walls):
         # carry the truth's motion from the first received pose's time onto that pose.
         first, last = self.poses[0], self.poses[-1]
         t0 = min(truth, key=lambda p: abs(p[0] - first.header.stamp.to_sec()))

@@ -91,15 +91,15 @@ std::vector<Parameter<S>> mapEntries() {
       // --- Map (DP-SLAM 2.0 laser-penetration grid, shared by all particles) ---
       {"map_resolution", "map", FIELD(slam.map_resolution), "m", above(0), "cell size (the original used 0.0286)",
        kUser},
-      {"map_align_to_walls", "map", FIELD(slam.map_align_to_walls), "bool", anyValue(),
+      {"align_to_walls", "map", FIELD(slam.map_align_to_walls), "bool", anyValue(),
        "the map frame's axes run along the first scan's dominant wall direction (modulo 90 deg, as the odometry's "
        "align_to_walls finds it) instead of the first heading: the map comes out square to the building; the first "
-       "pose is then (0, 0, -that angle)",
+       "pose is then (0, 0, -that angle). The same key as the odometry's: one choice for the building",
        kUser},
       {"no_return_range", "map", FIELD(slam.no_return_range), "m", above(0),
        "a no-return beam (+inf) is free space up to min(this, the scan's range_max)", kUser},
       {"map_wall_min_strength", "map", FIELD(slam.map_wall_min_strength), "-", closedInterval(0, 1),
-       "map_align_to_walls only when the first scan's chords agree at least this much", kAdvanced},
+       "align_to_walls only when the first scan's chords agree at least this much", kAdvanced},
       {"trace_max_range", "map", FIELD(slam.trace_max_range), "m", above(0),
        "beams are traced this far at most; longer returns count as free space up to it; must exceed "
        "map_resolution",
