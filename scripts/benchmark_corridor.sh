@@ -3,7 +3,7 @@
 # of a floor plan (default: the loop building's east corridor, plans/loop_building_east.txt) with several
 # simulator seeds, runs the laser odometry and the full SLAM on each, and prints how much longer (+) or
 # shorter (-) than the truth each made the leg, in % of its length. A map that comes out short in a
-# corridor ("maps come out too short", users.md) shows here in a minute per seed, where the 2-lap loop
+# corridor ("maps come out too short", a common complaint about laser-only SLAM) shows here in a minute per seed, where the 2-lap loop
 # (scripts/benchmark_loop.sh) takes ten. The leg measured: from the 2nd to the 3rd waypoint, 0.5 m inside.
 # Usage: scripts/benchmark_corridor.sh [--seeds "1 2 3"] [--config FILE.yaml] [--plan PLAN.yaml --path WAYPOINTS.txt]
 set -euo pipefail

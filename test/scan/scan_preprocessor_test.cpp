@@ -16,7 +16,7 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// A URG-04LX-like scan (users.md: 683 beams over 240°, 0.02–5.6 m) with every range set to `r`.
+// A URG-04LX-like scan (its datasheet: 683 beams over 240°, 0.02–5.6 m) with every range set to `r`.
 LaserScan urgScan(std::size_t n = 683, float r = 1.0f) {
   LaserScan s;
   s.stamp = 12.5;
