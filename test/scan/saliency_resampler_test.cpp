@@ -151,7 +151,7 @@ TEST(SaliencyResampler, CurvaturePeaksAtCorners) {
 
 TEST(SaliencyResampler, RarityFavoursTheRareOrientation) {
   // A corridor 2 m wide, 30 m long, whose end wall is 3 m ahead: the end wall is the only thing that
-  // constrains motion along the corridor (the corridor case users of laser-only SLAM run into), and few beams see it.
+  // constrains motion along the corridor (the case laser-only SLAM users run into), and few beams see it.
   std::vector<Segment> segs = {{{-15, -1}, {15, -1}}, {{-15, 1}, {15, 1}}, {{3, -1}, {3, 1}}};
   LaserScan s = roomLaserScan(0.0);
   for (int i = 0; i < 683; ++i) s.ranges[i] = static_cast<float>(castRay(segs, s.angle_min + i * s.angle_increment));
