@@ -273,6 +273,9 @@ class DpSlamMap : public AncestryHooks {
   /// shrinks/frees the block. Does not touch the removed entry's owner list.
   void removeFromCell(int tile, int cell, int slot);
   void removeFromOwner(int owner, std::uint32_t back);
+  /// Compacts the entry block classes that have many free blocks (EntryPool::compact). Moves blocks:
+  /// only where no entry pointer is held.
+  void compactPool();
   /// The tile under a trace, kept while the trace stays in it.
   struct Cursor {
     int tx = std::numeric_limits<int>::min(), ty = 0;

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <new>
 #include <stdexcept>
 #include <string>
+
+#include <sys/mman.h>
 
 namespace laser_dpslam {
 
@@ -22,7 +25,10 @@ void requireNodeId(int node) {
 // ---------------------------------------------------------------------------------------------------
 // Entry blocks: size classes of capacity 1, 2, 4, … entries, carved out of fixed-size chunks so that a
 // growing map never reallocates (and copies) what it already holds. Freed blocks go to a per-class free
-// list and are reused first.
+// list and are reused first; when many of a class are free, compact() moves the live ones down and
+// returns the emptied chunks (the particles' entries come and go by the million, and a class's free
+// blocks serve no other class). Chunks are mapped pages of their own, so that freeing one gives its
+// memory back to the system whatever the heap around it looks like.
 class DpSlamMap::EntryPool {
  public:
   static constexpr int kClasses = 20;
@@ -39,25 +45,61 @@ class DpSlamMap::EntryPool {
       free_[cls].pop_back();
       return b;
     }
-    const std::uint32_t per_chunk = 1u << blocksShift(cls);
-    if (next_[cls] == chunks_[cls].size() * per_chunk) {
-      chunks_[cls].emplace_back(new MapEntry[static_cast<std::size_t>(per_chunk) << cls]);
-    }
+    if (next_[cls] == chunks_[cls].size() * blocksPerChunk(cls)) chunks_[cls].push_back(mapChunk(chunkBytes(cls)));
     return next_[cls]++;
   }
   void release(int cls, std::uint32_t block) { free_[cls].push_back(block); }
+  /// Whether compact(cls) would give back enough to be worth its pass over the class: a quarter of
+  /// its blocks and at least two chunks free.
+  bool wantsCompaction(int cls) const {
+    const std::size_t n = free_[cls].size();
+    return n >= 2 * static_cast<std::size_t>(blocksPerChunk(cls)) && 4 * n >= next_[cls];
+  }
+  /// Moves the live blocks of `cls` into the lowest block numbers and frees the chunks left empty;
+  /// moved(old, new) is called after each block's entries were copied to `new`.
+  template <class F>
+  void compact(int cls, F&& moved) {
+    const std::uint32_t live = next_[cls] - static_cast<std::uint32_t>(free_[cls].size());
+    std::vector<std::uint32_t> holes;  // free blocks below `live`: exactly as many as live blocks above
+    std::vector<bool> free_above(next_[cls] - live, false);
+    for (std::uint32_t b : free_[cls]) {
+      if (b < live) holes.push_back(b);
+      else free_above[b - live] = true;
+    }
+    std::size_t h = 0;
+    for (std::uint32_t b = live; b < next_[cls]; ++b) {
+      if (free_above[b - live]) continue;
+      std::memcpy(static_cast<void*>(at(cls, holes[h])), at(cls, b), sizeof(MapEntry) << cls);
+      moved(b, holes[h++]);
+    }
+    next_[cls] = live;
+    std::vector<std::uint32_t>().swap(free_[cls]);
+    chunks_[cls].resize((live + blocksPerChunk(cls) - 1) / blocksPerChunk(cls));
+  }
   std::size_t bytes() const {
     std::size_t b = 0;
     for (int c = 0; c < kClasses; ++c) {
-      b += chunks_[c].size() * ((static_cast<std::size_t>(1) << blocksShift(c)) << c) * sizeof(MapEntry);
-      b += free_[c].capacity() * sizeof(std::uint32_t);
+      b += chunks_[c].size() * chunkBytes(c) + free_[c].capacity() * sizeof(std::uint32_t);
     }
     return b;
   }
 
  private:
+  /// Pages from mmap, unmapped on destruction; MapEntry is trivially copyable, written before read.
+  struct Unmap {
+    std::size_t bytes = 0;
+    void operator()(MapEntry* p) const { ::munmap(p, bytes); }
+  };
+  using Chunk = std::unique_ptr<MapEntry, Unmap>;
+  static Chunk mapChunk(std::size_t bytes) {
+    void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    return Chunk(static_cast<MapEntry*>(p), Unmap{bytes});
+  }
+  static std::uint32_t blocksPerChunk(int cls) { return 1u << blocksShift(cls); }
+  static std::size_t chunkBytes(int cls) { return (static_cast<std::size_t>(blocksPerChunk(cls)) << cls) * sizeof(MapEntry); }
   static int blocksShift(int cls) { return cls >= kChunkShift ? 0 : kChunkShift - cls; }
-  std::vector<std::unique_ptr<MapEntry[]>> chunks_[kClasses];
+  std::vector<Chunk> chunks_[kClasses];
   std::vector<std::uint32_t> free_[kClasses];
   std::uint32_t next_[kClasses] = {};
 };
@@ -212,7 +254,7 @@ int DpSlamMap::appendEntry(int tile, int cell, const MapEntry& e) {
     setBlock(c, ncls, nb);
   }
   if (c.size == 0xFFFF) throw std::length_error("DpSlamMap: too many entries in one cell");
-  c.entries[c.size] = e;
+  new (&c.entries[c.size]) MapEntry(e);  // the pool hands out raw pages
   ++entries_;
   return c.size++;
 }
@@ -258,6 +300,19 @@ void DpSlamMap::deleteNode(int id) {
   auto& list = owned_[id];
   for (const EntryRef& r : list) removeFromCell(r.tile, r.cell, r.slot);
   std::vector<EntryRef>().swap(list);  // free the storage
+  compactPool();
+}
+
+void DpSlamMap::compactPool() {
+  for (int cls = 0; cls < EntryPool::kClasses; ++cls) {
+    if (!pool_->wantsCompaction(cls)) continue;
+    pool_->compact(cls, [&](std::uint32_t, std::uint32_t to) {
+      // A live block's first entry names its cell through the owner's list.
+      const MapEntry& e = *pool_->at(cls, to);
+      const EntryRef& r = owned_[e.owner][e.back];
+      setBlock(tiles_[r.tile]->cells[r.cell], cls, to);
+    });
+  }
 }
 
 void DpSlamMap::mergeChildIntoParent(int child, int parent) {
@@ -294,6 +349,7 @@ void DpSlamMap::mergeChildIntoParent(int child, int parent) {
     pl.push_back(cl[i]);
   }
   std::vector<EntryRef>().swap(cl);
+  compactPool();
 }
 
 // --- Lookups ---------------------------------------------------------------------------------------
