@@ -300,7 +300,7 @@ TEST(DpSlamMap, PlanBeamOnlyUnknownLeavesTheKnownCellsOut) {
     EXPECT_EQ(unknown[k].d, all[k + 4].d);
     EXPECT_EQ(unknown[k].hit, all[k + 4].hit);
   }
-  EXPECT_EQ(unknown.back().hit, 1.0f);
+  EXPECT_EQ(unknown.back().hit, 1);
   // A row the root's entries are not visible to (a beam elsewhere) is all unknown.
   b.oy = 1.05;
   unknown.clear();
@@ -555,7 +555,7 @@ TEST(DpSlamMap, CellNormalsBelongToTheLineageThatWroteThem) {
   EXPECT_EQ(normalSeen(map, 10, 0, grandkids[1], tree), DpSlamMap::quantizeNormal(0.0, 1.0));
   EXPECT_EQ(map.check(), "");
   // Node IDs must fit the entries' 16-bit owners.
-  std::vector<DpSlamMap::CellWrite> w{{1, 1, 0.1f, 0.0f}};
+  std::vector<DpSlamMap::CellWrite> w{{1, 1, 0.1f, 0}};
   EXPECT_THROW(map.applyWrites(w, 0, DpSlamMap::kMaxNodeId + 1, cache), std::out_of_range);
 }
 

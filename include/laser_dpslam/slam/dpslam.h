@@ -200,7 +200,8 @@ class DpSlam {
   std::unique_ptr<WorkerPool> pool_;
   std::vector<LookupCache> caches_;  ///< one per worker (scoring)
   LookupCache update_cache_;
-  std::vector<std::vector<DpSlamMap::CellWrite>> writes_;  ///< per particle, reused
+  std::vector<std::vector<DpSlamMap::CellWrite>> writes_;  ///< per particle, reused up to kKeptWrites
+  static constexpr std::size_t kKeptWrites = 8192;
   GaussianSampler rng_;
   AncestryTree tree_;
   DpSlamMap map_;

@@ -212,8 +212,8 @@ class DpSlamMap : public AncestryHooks {
   /// for `node` in order, with the same rules as addBeam.
   struct CellWrite {
     std::int32_t ix, iy;
-    float d;    ///< m of beam through the cell
-    float hit;  ///< 1 for the cell where the beam stopped, else 0
+    float d;               ///< m of beam through the cell
+    std::uint8_t hit = 0;  ///< 1 for the cell where the beam stopped, else 0 (a byte: 16-byte writes)
     std::uint8_t normal = 0;  ///< quantised normal the writer's entry takes (0 = keep its own), see setCellNormals
     std::uint8_t offset = 0;  ///< a stop's quantised offset along the entry's (new) normal (0 = none), see setSurfaceOffsets
   };

@@ -228,7 +228,10 @@ void DpSlam::planWrites(const std::vector<int>& who, const std::vector<Pose2D>& 
 void DpSlam::applyWrites(const std::vector<int>& who, const std::vector<int>& nodes) {
   update_cache_.begin(tree_, nodes);
   for (std::size_t s = 0; s < who.size(); ++s) {
-    map_.applyWrites(writes_[who[s]], static_cast<int>(s), nodes[s], update_cache_, config_.free_saturation_distance);
+    auto& w = writes_[who[s]];
+    map_.applyWrites(w, static_cast<int>(s), nodes[s], update_cache_, config_.free_saturation_distance);
+    // A scan into unmapped space plans ten times the usual writes: no particle keeps a buffer that large.
+    if (w.capacity() > kKeptWrites) std::vector<DpSlamMap::CellWrite>().swap(w);
   }
 }
 

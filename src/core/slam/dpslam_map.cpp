@@ -12,6 +12,7 @@
 namespace laser_dpslam {
 
 static_assert(sizeof(MapEntry) == 16, "MapEntry grew: the map's memory is mostly entries");
+static_assert(sizeof(DpSlamMap::CellWrite) == 16, "CellWrite grew: a scan into new space plans millions");
 
 namespace {
 void requireNodeId(int node) {
@@ -634,7 +635,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
     w.ix = ix;
     w.iy = iy;
     w.d = static_cast<float>((t1 - t0) * chordFactor(q, b, t1 >= surface_from));
-    w.hit = end ? 1.0f : 0.0f;
+    w.hit = end ? 1 : 0;
     if (end) {
       w.normal = static_cast<std::uint8_t>(beam_normal);
       const int nq = beam_normal ? beam_normal : q;  // the normal the entry has after this write
@@ -665,7 +666,7 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
     ne.offset = w.offset;
     if (vis) {
       MapEntry& v = *vis;
-      if (w.hit == 0.0f && v.hits == 0.0f && v.distance >= saturation) continue;
+      if (w.hit == 0 && v.hits == 0.0f && v.distance >= saturation) continue;
       const int nq = w.normal ? w.normal : v.normal;
       const std::uint8_t offset = w.offset ? meanOffset(v.normal, v.offset, v.hits, nq, w.offset) : v.offset;
       if (v.owner == node) {
