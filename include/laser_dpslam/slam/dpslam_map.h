@@ -100,20 +100,24 @@ class LookupCache {
  private:
   friend class DpSlamMap;
   static constexpr int kTileCells = 64 * 64;
+  static constexpr std::uint32_t kStaleIterations = 32;  ///< a tile's rows unused this long are freed
   /// A cell's row is valid when its stamp is the iteration's; the two side by side share a cache line.
   struct TileRows {
     struct {
       std::uint32_t stamp;
       std::uint32_t row;
     } cells[kTileCells];
+    std::uint32_t used = 0;  ///< the last iteration (stamp) a trace entered the tile
   };
   std::vector<int> slot_nodes_;
   std::vector<int> parent_;  ///< snapshot of the tree's parents, by node ID
   int root_ = -1;
   std::uint32_t stamp_ = 0;
   std::vector<std::unique_ptr<TileRows>> tiles_;  ///< by map tile ID
-  std::vector<std::int32_t> rows_;                 ///< slots() values per row: entry index or -1
-  std::vector<std::int32_t> scratch_;
+  /// slots() values per row: entry index or -1. A cell holds one entry per node ID at most, so an
+  /// index fits 16 bits (DpSlamMap::kMaxNodeId); the rows are most of a cache's memory.
+  std::vector<std::int16_t> rows_;
+  std::vector<std::int16_t> scratch_;
   std::vector<std::int32_t> memo_;                 ///< by node ID, while building a row
   std::vector<std::uint32_t> memo_stamp_;
   std::uint32_t memo_counter_ = 0;

@@ -12,6 +12,7 @@
 namespace laser_dpslam {
 
 static_assert(sizeof(MapEntry) == 16, "MapEntry grew: the map's memory is mostly entries");
+static_assert(DpSlamMap::kMaxNodeId <= 32767, "LookupCache rows hold entry indices in 16 bits");
 static_assert(sizeof(DpSlamMap::CellWrite) == 16, "CellWrite grew: a scan into new space plans millions");
 
 namespace {
@@ -118,6 +119,10 @@ void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_n
     memo_stamp_.resize(tree.idCapacity(), 0);
   }
   rows_.clear();
+  // The rows of a tile no trace entered for a while go: the cache follows the robot, not the whole map.
+  for (auto& t : tiles_) {
+    if (t && stamp_ - t->used > kStaleIterations) t.reset();
+  }
   if (++stamp_ == 0) {  // wrapped: forget every stamp
     for (auto& t : tiles_) {
       if (t) std::memset(t->cells, 0, sizeof(t->cells));
@@ -127,7 +132,7 @@ void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_n
 }
 
 std::size_t LookupCache::memoryBytes() const {
-  std::size_t b = rows_.capacity() * sizeof(std::int32_t) + tiles_.capacity() * sizeof(void*);
+  std::size_t b = rows_.capacity() * sizeof(std::int16_t) + tiles_.capacity() * sizeof(void*);
   for (const auto& t : tiles_) {
     if (t) b += sizeof(TileRows);
   }
@@ -415,7 +420,7 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
   const MapEntry* e = entriesOf(c);
   const std::size_t slots = cache.slot_nodes_.size();
   cache.scratch_.resize(slots);
-  std::int32_t* out = cache.scratch_.data();
+  std::int16_t* out = cache.scratch_.data();
   if (++cache.memo_counter_ == 0) {  // wrapped
     std::fill(cache.memo_stamp_.begin(), cache.memo_stamp_.end(), 0u);
     cache.memo_counter_ = 1;
@@ -450,7 +455,7 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
       cache.memo_[x] = value;
       cache.memo_stamp_[x] = mark;
     }
-    out[s] = cache.memo_[cache.slot_nodes_[s]];
+    out[s] = static_cast<std::int16_t>(cache.memo_[cache.slot_nodes_[s]]);
     uniform = uniform && out[s] == out[0];
   }
   LookupCache::TileRows& tr = *cache.tiles_[tile];
@@ -470,12 +475,12 @@ void DpSlamMap::setRowSlot(LookupCache& cache, int tile, int cell, int slot, int
   const std::size_t slots = cache.slot_nodes_.size();
   std::uint32_t word = tr.cells[cell].row;
   if (word & kUniform) {  // materialise the row
-    const std::int32_t v = static_cast<std::int32_t>(word & ~kUniform) - 1;
+    const auto v = static_cast<std::int16_t>(static_cast<std::int32_t>(word & ~kUniform) - 1);
     word = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
     cache.rows_.insert(cache.rows_.end(), slots, v);
     tr.cells[cell].row = word;
   }
-  cache.rows_[static_cast<std::size_t>(word) * slots + slot] = value;
+  cache.rows_[static_cast<std::size_t>(word) * slots + slot] = static_cast<std::int16_t>(value);
 }
 
 inline bool DpSlamMap::seek(Cursor& cur, int ix, int iy, LookupCache& cache) const {
@@ -489,6 +494,7 @@ inline bool DpSlamMap::seek(Cursor& cur, int ix, int iy, LookupCache& cache) con
   if (static_cast<std::size_t>(cur.tile) >= cache.tiles_.size()) cache.tiles_.resize(tiles_.size());
   auto& tr = cache.tiles_[cur.tile];
   if (!tr) tr.reset(new LookupCache::TileRows());
+  tr->used = cache.stamp_;
   cur.rows = tr.get();
   return true;
 }
