@@ -253,7 +253,7 @@ class DpSlamMap : public AncestryHooks {
     MapEntry* entries = nullptr;  ///< the block's address (blocks never move): one load less per look-up
     std::uint32_t block = 0;
     std::uint16_t size = 0;
-    std::uint8_t cls = 0xFF;  ///< size class of the block (capacity 1 << cls); 0xFF = none
+    std::uint8_t cls = 0xFF;  ///< size class of the block (EntryPool::capacity); 0xFF = none
   };
   struct Tile {
     int tx = 0, ty = 0;
@@ -271,6 +271,7 @@ class DpSlamMap : public AncestryHooks {
   static int cellInTile(int ix, int iy) { return ((iy & (kTileSize - 1)) << kTileShift) | (ix & (kTileSize - 1)); }
   MapEntry* entriesOf(const Cell& c) const;
   void setBlock(Cell& c, int cls, std::uint32_t block);  ///< c takes block `block` of class `cls`
+  void moveToClass(Cell& c, int cls);  ///< copies c's entries to a new block of class `cls`
   /// Appends an entry to the cell (growing its block); returns its slot.
   int appendEntry(int tile, int cell, const MapEntry& e);
   /// Removes the entry at `slot` (swap with the last, fixing the moved entry's back-reference) and

@@ -25,22 +25,28 @@ void requireNodeId(int node) {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------
-// Entry blocks: size classes of capacity 1, 2, 4, … entries, carved out of fixed-size chunks so that a
-// growing map never reallocates (and copies) what it already holds. Freed blocks go to a per-class free
-// list and are reused first; when many of a class are free, compact() moves the live ones down and
-// returns the emptied chunks (the particles' entries come and go by the million, and a class's free
-// blocks serve no other class). Chunks are mapped pages of their own, so that freeing one gives its
-// memory back to the system whatever the heap around it looks like.
+// Entry blocks: size classes of capacity 1, 2, 3, 4, 6, 8, 12, … entries (steps of 1.5 and 4/3: a cell
+// seen by every particle holds a few more entries than there are particles, and doubling left a third
+// of the pool empty), carved out of fixed-size chunks so that a growing map never reallocates (and
+// copies) what it already holds. Freed blocks go to a per-class free list and are reused first; when
+// many of a class are free, compact() moves the live ones down and returns the emptied chunks (the
+// particles' entries come and go by the million, and a class's free blocks serve no other class).
+// Chunks are mapped pages of their own, so that freeing one gives its memory back to the system
+// whatever the heap around it looks like.
 class DpSlamMap::EntryPool {
  public:
-  static constexpr int kClasses = 20;
-  static constexpr int kChunkShift = 14;  ///< 16384 entries per chunk (or one block, if larger)
+  static constexpr int kClasses = 30;        ///< up to 32768 entries: one per node ID
+  static constexpr int kChunkEntries = 16384;  ///< per chunk (or one block, if larger)
 
+  static constexpr std::uint32_t capacity(int cls) {
+    return cls == 0 ? 1u : (cls & 1) ? 1u << ((cls + 1) / 2) : 3u << (cls / 2 - 1);
+  }
   MapEntry* at(int cls, std::uint32_t block) const {
-    const int shift = blocksShift(cls);
-    return chunks_[cls][block >> shift].get() + (static_cast<std::size_t>(block & ((1u << shift) - 1)) << cls);
+    const std::uint32_t per = blocksPerChunk(cls);
+    return chunks_[cls][block / per].get() + static_cast<std::size_t>(block % per) * capacity(cls);
   }
   std::uint32_t allocate(int cls) {
+    static_assert(capacity(kClasses - 1) > kMaxNodeId, "a cell's entries (one per node ID) fit the largest class");
     if (cls >= kClasses) throw std::length_error("DpSlamMap: too many entries in one cell");
     if (!free_[cls].empty()) {
       const std::uint32_t b = free_[cls].back();
@@ -71,7 +77,7 @@ class DpSlamMap::EntryPool {
     std::size_t h = 0;
     for (std::uint32_t b = live; b < next_[cls]; ++b) {
       if (free_above[b - live]) continue;
-      std::memcpy(static_cast<void*>(at(cls, holes[h])), at(cls, b), sizeof(MapEntry) << cls);
+      std::memcpy(static_cast<void*>(at(cls, holes[h])), at(cls, b), sizeof(MapEntry) * capacity(cls));
       moved(b, holes[h++]);
     }
     next_[cls] = live;
@@ -98,9 +104,10 @@ class DpSlamMap::EntryPool {
     if (p == MAP_FAILED) throw std::bad_alloc();
     return Chunk(static_cast<MapEntry*>(p), Unmap{bytes});
   }
-  static std::uint32_t blocksPerChunk(int cls) { return 1u << blocksShift(cls); }
-  static std::size_t chunkBytes(int cls) { return (static_cast<std::size_t>(blocksPerChunk(cls)) << cls) * sizeof(MapEntry); }
-  static int blocksShift(int cls) { return cls >= kChunkShift ? 0 : kChunkShift - cls; }
+  static std::uint32_t blocksPerChunk(int cls) { return std::max(1u, kChunkEntries / capacity(cls)); }
+  static std::size_t chunkBytes(int cls) {
+    return static_cast<std::size_t>(blocksPerChunk(cls)) * capacity(cls) * sizeof(MapEntry);
+  }
   std::vector<Chunk> chunks_[kClasses];
   std::vector<std::uint32_t> free_[kClasses];
   std::uint32_t next_[kClasses] = {};
@@ -247,17 +254,20 @@ bool DpSlamMap::bounds(int* x0, int* y0, int* x1, int* y1) const {
 }
 
 // --- Entries ---------------------------------------------------------------------------------------
+void DpSlamMap::moveToClass(Cell& c, int cls) {
+  const std::uint32_t nb = pool_->allocate(cls);
+  std::memcpy(static_cast<void*>(pool_->at(cls, nb)), c.entries, sizeof(MapEntry) * c.size);
+  pool_->release(c.cls, c.block);
+  setBlock(c, cls, nb);
+}
+
 int DpSlamMap::appendEntry(int tile, int cell, const MapEntry& e) {
   Cell& c = tiles_[tile]->cells[cell];
   if (c.size == 0) {
     if (c.cls == 0xFF) setBlock(c, 0, pool_->allocate(0));
     ++observed_cells_;
-  } else if (c.size == (1u << c.cls)) {
-    const int ncls = c.cls + 1;
-    const std::uint32_t nb = pool_->allocate(ncls);
-    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
-    pool_->release(c.cls, c.block);
-    setBlock(c, ncls, nb);
+  } else if (c.size == EntryPool::capacity(c.cls)) {
+    moveToClass(c, c.cls + 1);
   }
   if (c.size == 0xFFFF) throw std::length_error("DpSlamMap: too many entries in one cell");
   new (&c.entries[c.size]) MapEntry(e);  // the pool hands out raw pages
@@ -281,12 +291,10 @@ void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
     c.block = 0;
     c.entries = nullptr;
     --observed_cells_;
-  } else if (c.cls > 0 && c.size <= ((1u << c.cls) >> 2)) {
-    const int ncls = c.cls - 1;
-    const std::uint32_t nb = pool_->allocate(ncls);
-    std::memcpy(pool_->at(ncls, nb), c.entries, sizeof(MapEntry) * c.size);
-    pool_->release(c.cls, c.block);
-    setBlock(c, ncls, nb);
+  } else if (c.size == 1 && c.cls > 0) {
+    moveToClass(c, 0);  // the usual end of a cell's branches: only the root's entry is left
+  } else if (c.cls > 0 && c.size <= EntryPool::capacity(c.cls - 1) / 2) {
+    moveToClass(c, c.cls - 1);
   }
 }
 
