@@ -233,6 +233,55 @@ TEST(DpSlamMap, PruningFreesCellsAndStorageIsReused) {
   EXPECT_EQ(w.map.check(), "");
 }
 
+// Killing most particles of a large map frees most blocks of the big entry classes: the pool compacts
+// them (moving live blocks), gives the memory back, and nothing any survivor sees changes.
+TEST(DpSlamMap, CompactionAfterPruningKeepsLookupsAndFreesMemory) {
+  AncestryTree tree;
+  DpSlamMap map(0.1, 4.0);
+  const int root = tree.createRoot();
+  constexpr int kSide = 100, kP = 40;
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) map.observe(x, y, root, tree, 0.1, (x + y) % 5 == 0);
+  }
+  std::vector<int> leaves = tree.advance({root}, std::vector<int>(kP, 0), 1, map);
+  std::mt19937_64 rng(3);
+  for (int leaf : leaves) {
+    for (int y = 0; y < kSide; ++y) {
+      for (int x = 0; x < kSide; ++x) {
+        if (rng() % 10 < 7) map.observe(x, y, leaf, tree, 0.01 * (1 + rng() % 10), rng() % 4 == 0);
+      }
+    }
+  }
+  const auto survivorsSee = [&](const std::vector<int>& nodes) {
+    std::vector<Seen> v;
+    for (int node : nodes) {
+      for (int y = 0; y < kSide; ++y) {
+        for (int x = 0; x < kSide; ++x) v.push_back(seen(map.lookup(x, y, node, tree)));
+      }
+    }
+    return v;
+  };
+  const std::size_t full = map.memoryBytes();
+  // Every fourth particle survives, twice over (no collapse): cells keep 5 to 11 of up to 41 entries.
+  std::vector<int> parents, kept;
+  for (int j = 0; j < kP; j += 4) {
+    parents.insert(parents.end(), {j, j});
+    kept.insert(kept.end(), {leaves[j], leaves[j]});
+  }
+  const std::vector<Seen> before = survivorsSee(kept);
+  leaves = tree.advance(leaves, parents, 2, map);
+  ASSERT_EQ(map.check(), "");
+  EXPECT_EQ(survivorsSee(leaves), before);
+  EXPECT_LT(map.memoryBytes(), full / 2);
+  // One lineage left: everything collapses into the root, one entry per cell.
+  const std::vector<Seen> last = survivorsSee({leaves[0]});
+  leaves = tree.advance(leaves, {0}, 3, map);
+  ASSERT_EQ(map.check(), "");
+  EXPECT_EQ(survivorsSee(leaves), last);
+  EXPECT_EQ(map.entryCount(), static_cast<std::size_t>(kSide * kSide));
+  EXPECT_LT(map.memoryBytes(), full / 8);
+}
+
 TEST(DpSlamMap, GrowsInEveryDirection) {
   AncestryTree tree;
   DpSlamMap map(0.05, 4.0);

@@ -58,10 +58,10 @@ class DpSlamMap::EntryPool {
   }
   void release(int cls, std::uint32_t block) { free_[cls].push_back(block); }
   /// Whether compact(cls) would give back enough to be worth its pass over the class: a quarter of
-  /// its blocks and at least two chunks free.
+  /// its blocks and at least a chunk free.
   bool wantsCompaction(int cls) const {
     const std::size_t n = free_[cls].size();
-    return n >= 2 * static_cast<std::size_t>(blocksPerChunk(cls)) && 4 * n >= next_[cls];
+    return n >= blocksPerChunk(cls) && 4 * n >= next_[cls];
   }
   /// Moves the live blocks of `cls` into the lowest block numbers and frees the chunks left empty;
   /// moved(old, new) is called after each block's entries were copied to `new`.
