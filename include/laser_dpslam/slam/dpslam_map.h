@@ -250,7 +250,7 @@ class DpSlamMap : public AncestryHooks {
 
  private:
   struct Cell {
-    MapEntry* entries = nullptr;  ///< the block's address (blocks never move): one load less per look-up
+    MapEntry* entries = nullptr;  ///< the block's address (re-set when compaction moves it): one load less per look-up
     std::uint32_t block = 0;
     std::uint16_t size = 0;
     std::uint8_t cls = 0xFF;  ///< size class of the block (EntryPool::capacity); 0xFF = none
