@@ -109,10 +109,7 @@ class DpSlamNode {
 
   void onOdom(const nav_msgs::Odometry::ConstPtr& msg) {
     // Keep the recent messages: their twist covariances make the motion noise up to the scan with the same stamp.
-    const int idx[3] = {0, 1, 5};
-    Eigen::Matrix3d cov;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) cov(r, c) = msg->twist.covariance[idx[r] * 6 + idx[c]];
+    const Eigen::Matrix3d cov = planarCovarianceFromMsg(msg->twist.covariance);
     const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
     {
       std::lock_guard<std::mutex> lock(odom_mutex_);
@@ -268,9 +265,7 @@ class DpSlamNode {
     p.header.stamp = stamp;  // the scan's time, never now()
     p.header.frame_id = map_frame_;
     p.pose.pose = toPoseMsg(u.pose);
-    const int idx[3] = {0, 1, 5};
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) p.pose.covariance[idx[r] * 6 + idx[c]] = u.covariance(r, c);
+    setPlanarCovariance(u.covariance, &p.pose.covariance);
     pose_pub_.publish(p);
 
     // map→odom = map→base ⊕ (odom→base)⁻¹ (REP-105: the SLAM corrects the odometry's drift).

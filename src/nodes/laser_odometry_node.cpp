@@ -137,20 +137,15 @@ class LaserOdometryNode {
     odom.twist.twist.linear.x = u.velocity.x();
     odom.twist.twist.linear.y = u.velocity.y();
     odom.twist.twist.angular.z = u.velocity.z();
-    // 6×6 (x, y, z, roll, pitch, yaw); the planar 3×3 goes to indices {0, 1, 5}. Unused axes get a large
-    // variance so that consumers (robot_localization) ignore them.
-    const int idx[3] = {0, 1, 5};
+    // 6×6 (x, y, z, roll, pitch, yaw) with the planar 3×3 in it. Unused axes get a large variance so that
+    // consumers (robot_localization) ignore them.
     const double dt = scan.scan_time > 0 ? scan.scan_time : 0.1;
     for (int i = 0; i < 6; ++i) {
       odom.pose.covariance[i * 6 + i] = 1e6;
       odom.twist.covariance[i * 6 + i] = 1e6;
     }
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
-        odom.pose.covariance[idx[r] * 6 + idx[c]] = u.pose_covariance(r, c);
-        odom.twist.covariance[idx[r] * 6 + idx[c]] = u.delta_covariance(r, c) / (dt * dt);
-      }
-    }
+    setPlanarCovariance(u.pose_covariance, &odom.pose.covariance);
+    setPlanarCovariance(u.delta_covariance / (dt * dt), &odom.twist.covariance);
     odom_pub_.publish(odom);
 
     if (publish_tf_) {

@@ -96,6 +96,22 @@ geometry_msgs::Transform toTransformMsg(const Pose2D& pose) {
   return t;
 }
 
+namespace {
+constexpr int kPlanarAxes[3] = {0, 1, 5};  // x, y, yaw among x, y, z, roll, pitch, yaw
+}  // namespace
+
+Eigen::Matrix3d planarCovarianceFromMsg(const boost::array<double, 36>& msg) {
+  Eigen::Matrix3d cov;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) cov(r, c) = msg[kPlanarAxes[r] * 6 + kPlanarAxes[c]];
+  return cov;
+}
+
+void setPlanarCovariance(const Eigen::Matrix3d& cov, boost::array<double, 36>* msg) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) (*msg)[kPlanarAxes[r] * 6 + kPlanarAxes[c]] = cov(r, c);
+}
+
 std::string cleanFrameId(const std::string& frame_id) {
   std::size_t i = 0;
   while (i < frame_id.size() && frame_id[i] == '/') ++i;

@@ -105,3 +105,20 @@ TEST(MsgConversion, ALeadingSlashIsStrippedFromFrameIds) {
   EXPECT_EQ(cleanFrameId("/robot/laser"), "robot/laser");
   EXPECT_EQ(cleanFrameId(""), "");
 }
+
+// A ROS 6×6 covariance holds the planar 3×3 in rows and columns x, y, yaw (0, 1, 5); the others are kept.
+TEST(MsgConversion, PlanarCovarianceGoesToXYAndYaw) {
+  Eigen::Matrix3d cov;
+  cov << 1, 2, 3, 2, 4, 5, 3, 5, 6;
+  boost::array<double, 36> msg;
+  msg.fill(-1.0);
+  setPlanarCovariance(cov, &msg);
+  EXPECT_EQ(msg[0], 1.0);
+  EXPECT_EQ(msg[1], 2.0);
+  EXPECT_EQ(msg[5], 3.0);
+  EXPECT_EQ(msg[30], 3.0);
+  EXPECT_EQ(msg[35], 6.0);
+  EXPECT_EQ(msg[2], -1.0);   // x–z untouched
+  EXPECT_EQ(msg[14], -1.0);  // z–z untouched
+  EXPECT_EQ(planarCovarianceFromMsg(msg), cov);
+}

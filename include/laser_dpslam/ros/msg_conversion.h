@@ -5,6 +5,9 @@
 #include <geometry_msgs/Transform.h>
 #include <sensor_msgs/LaserScan.h>
 
+#include <Eigen/Core>
+#include <boost/array.hpp>
+
 #include "laser_dpslam/common/laser_mount.h"
 #include "laser_dpslam/common/laser_scan.h"
 #include "laser_dpslam/common/pose2d.h"
@@ -24,6 +27,11 @@ LaserMount mountFromTransform(const geometry_msgs::Transform& msg);
 
 geometry_msgs::Pose toPoseMsg(const Pose2D& pose);
 geometry_msgs::Transform toTransformMsg(const Pose2D& pose);
+
+/// The planar (x, y, yaw) block of a ROS 6×6 covariance (x, y, z, roll, pitch, yaw): rows and columns 0, 1, 5.
+Eigen::Matrix3d planarCovarianceFromMsg(const boost::array<double, 36>& msg);
+/// Writes `cov` into that block of `msg`, leaving its other entries as they are.
+void setPlanarCovariance(const Eigen::Matrix3d& cov, boost::array<double, 36>* msg);
 
 /// tf2 rejects frame ids with a leading slash (old bags: "/laser"); strip it.
 std::string cleanFrameId(const std::string& frame_id);
