@@ -32,9 +32,6 @@ Eigen::Matrix3d MotionCovarianceWindow::deltaCovariance(std::int64_t from_ns, co
                                                         std::int64_t to_ns) const {
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   if (to_ns <= from_ns) return cov;
-  bool have_end = false;
-  for (const Sample& s : samples_) have_end = have_end || s.stamp_ns == to_ns;
-  if (!have_end) return cov;
   Pose2D motion;  // composed since from_pose
   Pose2D previous_pose = from_pose;
   std::int64_t previous_ns = from_ns;
@@ -57,7 +54,8 @@ Eigen::Matrix3d MotionCovarianceWindow::deltaCovariance(std::int64_t from_ns, co
     previous_ns = s.stamp_ns;
     first = false;
   }
-  return cov;
+  // The stamps increase, so the last message used has the stamp to_ns exactly when one does.
+  return previous_ns == to_ns ? cov : Eigen::Matrix3d::Zero();
 }
 
 void MotionCovarianceWindow::dropUntil(std::int64_t stamp_ns) {
