@@ -34,6 +34,7 @@
 #include "laser_dpslam/scan/scan_preprocessor.h"
 #include "laser_dpslam/slam/dpslam.h"
 #include "laser_dpslam/slam/dpslam_parameters.h"
+#include "laser_dpslam/slam/motion_covariance.h"
 
 using namespace laser_dpslam;
 
@@ -279,7 +280,8 @@ class OfflineRun {
   TrajectoryRefiner refiner_;
   std::unique_ptr<DpSlam> slam_;
   Pose2D slam_last_odom_;               // odometry pose of the last scan given to the SLAM
-  Eigen::Matrix3d slam_delta_cov_ = Eigen::Matrix3d::Zero();  // accumulated since then
+  Pose2D slam_pending_;                 // the odometry's own motion since then, composed
+  Eigen::Matrix3d slam_delta_cov_ = Eigen::Matrix3d::Zero();  // its covariance, composed the same way
   Eigen::Matrix3d odom_last_covariance_ = Eigen::Matrix3d::Zero();  // the odometry's pose covariance at the last scan
   bool slam_has_last_ = false;
   std::vector<double> slam_ms_;
@@ -329,6 +331,7 @@ void OfflineRun::startOver(double from, double to) {
   if (slam_) slam_->reset();
   refiner_.clear();
   slam_has_last_ = false;
+  slam_pending_ = Pose2D();
   slam_delta_cov_.setZero();
 }
 
@@ -509,7 +512,8 @@ void OfflineRun::feedSlam(const LaserScan& scan, const PreprocessedScan& pre, co
   Pose2D motion_pose = u.pose;
   const bool have_motion = motion_.empty() || interpolatePose(motion_, scan.stamp, &motion_pose);
   if (!have_motion) ++skipped_["slam_outside_motion_tum"];
-  if (slam_) slam_delta_cov_ += u.delta_covariance;  // a scan not given to the SLAM adds to the next delta's
+  // A scan not given to the SLAM adds to the next delta's covariance, composed as the node composes it.
+  if (slam_) composeMotion(slam_pending_, slam_delta_cov_, u.delta, u.delta_covariance);
   if (!slam_ || !have_motion) return;
   const Pose2D delta = slam_has_last_ && !u.reset ? between(slam_last_odom_, motion_pose) : Pose2D();
   const auto s0 = std::chrono::steady_clock::now();
@@ -520,6 +524,7 @@ void OfflineRun::feedSlam(const LaserScan& scan, const PreprocessedScan& pre, co
   if (!args_.slam_log.empty()) logSlam(scan.stamp);
   max_tree_nodes_ = std::max(max_tree_nodes_, last_slam_.tree_nodes);
   slam_last_odom_ = motion_pose;
+  slam_pending_ = Pose2D();
   slam_delta_cov_.setZero();
   slam_has_last_ = true;
 }

@@ -85,3 +85,27 @@ TEST(MotionCovariance, KeepsOrderCapacityAndForgetsWhatIsBehind) {
   EXPECT_TRUE(w.empty());
   EXPECT_EQ(w.newestStamp(), 0);
 }
+
+// dpslam_offline composes each scan's delta and delta covariance with composeMotion; the node gets the
+// same from the window over the odometry's messages: both must agree (to rounding of dt).
+TEST(MotionCovariance, ComposeMotionPerScanEqualsTheWindow) {
+  const double dt = 0.1;
+  const Pose2D poses[] = {Pose2D(), Pose2D(0.05, 0.01, 0.1), Pose2D(0.09, 0.03, 0.25), Pose2D(0.12, 0.08, 0.4)};
+  Eigen::Matrix3d v;
+  v << 0.04, 0.01, 0.002, 0.01, 0.09, 0.003, 0.002, 0.003, 0.01;
+  MotionCovarianceWindow w;
+  Pose2D motion;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Matrix3d vk = (1.0 + k) * v;
+    w.add(kT0 + k * kPeriod, poses[k], vk);
+    if (k > 0) composeMotion(motion, cov, between(poses[k - 1], poses[k]), vk * dt * dt);
+  }
+  const Eigen::Matrix3d c = w.deltaCovariance(kT0, poses[0], kT0 + 3 * kPeriod);
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c(r, k), cov(r, k), 1e-16);
+  const Pose2D end = between(poses[0], poses[3]);
+  EXPECT_NEAR(motion.x, end.x, 1e-12);
+  EXPECT_NEAR(motion.y, end.y, 1e-12);
+  EXPECT_NEAR(motion.theta, end.theta, 1e-12);
+}

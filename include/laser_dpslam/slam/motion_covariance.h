@@ -16,6 +16,11 @@
 
 namespace laser_dpslam {
 
+/// motion ← motion ⊕ step, and cov ← the first-order covariance of that composition (the two independent).
+/// The one way motion and its covariance are accumulated over scans: by DpSlam between filter updates, by
+/// MotionCovarianceWindow over odometry messages, by dpslam_offline over scans the SLAM does not receive.
+void composeMotion(Pose2D& motion, Eigen::Matrix3d& cov, const Pose2D& step, const Eigen::Matrix3d& step_cov);
+
 class MotionCovarianceWindow {
  public:
   /// Keeps the newest `capacity` messages at most (20 s of 50 Hz wheel odometry by default).

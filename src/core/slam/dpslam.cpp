@@ -6,6 +6,7 @@
 
 #include "laser_dpslam/common/worker_pool.h"
 #include "laser_dpslam/scan/wall_direction.h"
+#include "laser_dpslam/slam/motion_covariance.h"
 #include "laser_dpslam/slam/trajectory_smoother.h"
 
 namespace laser_dpslam {
@@ -22,14 +23,6 @@ bool travelThresholdReached(const Pose2D& motion, double distance, double angle)
 namespace {
 void require(bool ok, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("DpSlamConfig: ") + what);
-}
-
-/// a ⊕ b and the first-order covariance of the composition.
-void compose(Pose2D& a, Eigen::Matrix3d& cov_a, const Pose2D& b, const Eigen::Matrix3d& cov_b) {
-  Eigen::Matrix3d ja, jb;
-  composeJacobians(a, b, &ja, &jb);
-  cov_a = ja * cov_a * ja.transpose() + jb * cov_b * jb.transpose();
-  a = a * b;
 }
 }  // namespace
 
@@ -289,7 +282,7 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
     return u;
   }
 
-  compose(pending_, pending_cov_, delta, delta_cov);
+  composeMotion(pending_, pending_cov_, delta, delta_cov);
   motion_ = motion_ * delta;
   const bool moved_enough = travelThresholdReached(pending_, config_.min_travel_distance, config_.min_travel_angle);
   if (!usable || !moved_enough) {

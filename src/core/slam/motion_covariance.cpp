@@ -18,6 +18,13 @@ double seconds(std::int64_t ns) {
 }
 }  // namespace
 
+void composeMotion(Pose2D& motion, Eigen::Matrix3d& cov, const Pose2D& step, const Eigen::Matrix3d& step_cov) {
+  Eigen::Matrix3d ja, jb;
+  composeJacobians(motion, step, &ja, &jb);
+  cov = ja * cov * ja.transpose() + jb * step_cov * jb.transpose();
+  motion = motion * step;
+}
+
 bool MotionCovarianceWindow::add(std::int64_t stamp_ns, const Pose2D& pose, const Eigen::Matrix3d& velocity_cov) {
   if (!samples_.empty() && stamp_ns <= samples_.back().stamp_ns) return false;
   if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta) || !velocity_cov.allFinite()) {
@@ -35,24 +42,13 @@ Eigen::Matrix3d MotionCovarianceWindow::deltaCovariance(std::int64_t from_ns, co
   Pose2D motion;  // composed since from_pose
   Pose2D previous_pose = from_pose;
   std::int64_t previous_ns = from_ns;
-  bool first = true;
   for (const Sample& s : samples_) {
     if (s.stamp_ns <= from_ns) continue;
     if (s.stamp_ns > to_ns) break;
     const double dt = seconds(s.stamp_ns - previous_ns);
-    const Eigen::Matrix3d step = s.velocity_cov * dt * dt;
-    const Pose2D delta = between(previous_pose, s.pose);
-    if (first) {
-      cov = step;
-    } else {
-      Eigen::Matrix3d ja, jb;
-      composeJacobians(motion, delta, &ja, &jb);
-      cov = ja * cov * ja.transpose() + jb * step * jb.transpose();
-    }
-    motion = motion * delta;
+    composeMotion(motion, cov, between(previous_pose, s.pose), s.velocity_cov * dt * dt);
     previous_pose = s.pose;
     previous_ns = s.stamp_ns;
-    first = false;
   }
   // The stamps increase, so the last message used has the stamp to_ns exactly when one does.
   return previous_ns == to_ns ? cov : Eigen::Matrix3d::Zero();
