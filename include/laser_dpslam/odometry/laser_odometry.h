@@ -113,8 +113,8 @@ struct OdometryUpdate {
   MatchResult match;                  ///< its pose and weak_direction are in the matching frame (frameAngle())
   RangeFlow range_flow;               ///< the speed along match.weak_direction from the range flow (range_flow_gain)
   bool range_flow_applied = false;    ///< it (with the previous scan's) refuted the velocity and moved it
-  /// The velocity along match.weak_direction was held (degenerate_hold_time): the delta's variance along it
-  /// is the held velocity's over the scan interval, not the match's.
+  /// The velocity along match.weak_direction was held (degenerate_hold_time): the pose's variance along it
+  /// grows with the time held.
   bool velocity_held = false;
   bool wheel_prior = false;           ///< the motion prior was the wheel odometry's (addWheelOdometry)
   bool new_keyframe = false;
@@ -179,9 +179,9 @@ class LaserOdometry {
   /// velocity_ (and the range flow) after a match `dt` after the last one.
   void updateVelocity(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous, double dt,
                       OdometryUpdate& u);
-  /// Where the velocity was held: the delta's variance along the weak direction is the held velocity's,
-  /// and the pose's grows with the time held as that velocity's error does.
-  void heldCovariances(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u);
+  /// Where the velocity was held: the pose's variance along the weak direction grows with the time held,
+  /// as that velocity's error does.
+  void heldCovariance(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u);
   /// velocity_ along a degenerate match's weak direction: held, or moved by the range flow.
   void velocityAlongCorridor(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous,
                              double dt, const Eigen::Vector2d& before, const Eigen::Vector3d& measured,

@@ -68,7 +68,7 @@ constexpr double kHeldSpeedSigma = 0.02;
 constexpr double kHeldMinSpeedSigma = 0.005;  // m/s
 
 // The covariance of a motion whose component along the unit vector `weak` (translation) has variance `v`
-// (the wheels', a held velocity's) instead of the match's: the match's component along it is projected out.
+// (the wheels') instead of the match's: the match's component along it is projected out.
 Eigen::Matrix3d withVarianceAlong(const Eigen::Matrix3d& c, const Eigen::Vector2d& weak, double v) {
   Eigen::Matrix3d p = Eigen::Matrix3d::Identity();
   p.topLeftCorner<2, 2>() -= weak * weak.transpose();
@@ -196,7 +196,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   matchCovariances(previous, u);
   if (dt > 0.0 && dt <= config_.max_prior_gap) {
     updateVelocity(scan, mount, previous, dt, u);
-    heldCovariances(previous, scan.stamp, dt, u);
+    heldCovariance(previous, scan.stamp, dt, u);
   } else {
     held_since_ = kNoConstrainedMatch;
     last_flow_ = RangeFlow();
@@ -310,19 +310,17 @@ void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) 
   pose_covariance_ = Ja * kf.covariance * Ja.transpose() + u.match.bounded_covariance;
 }
 
-void LaserOdometry::heldCovariances(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u) {
+void LaserOdometry::heldCovariance(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u) {
   if (!u.velocity_held || u.wheel_prior) {
     held_since_ = kNoConstrainedMatch;
     return;
   }
-  // Along a held corridor direction the motion is the held velocity's (the match only damps its pull back
-  // towards the local map): its error per scan is σ_v·dt, not the match's ~2 cm, which let the SLAM's
-  // particles random-walk along corridors the map cannot tell apart (as with the wheels' variance).
+  // A velocity error is the same at every scan of the hold, so the position's error along the corridor
+  // grows linearly, σ_v·t, not as the root of the keyframes chained since. (The delta keeps the match's
+  // covariance: the held velocity's σ_v·dt there made the SLAM worse on the generated buildings,
+  // doc/experiments.md.)
   const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
   const double sigma_v = kHeldSpeedSigma * std::abs(weak.dot(velocity_.head<2>())) + kHeldMinSpeedSigma;
-  u.delta_covariance = withVarianceAlong(u.delta_covariance, weak, sigma_v * sigma_v * dt * dt);
-  // The pose: a velocity error is the same at every scan of the hold, so the position's error along the
-  // corridor grows linearly, σ_v·t, not as the root of the keyframes chained since.
   const Eigen::Vector2d w = u.match.weak_direction;  // matching frame, as pose_covariance_
   const double along = w.dot(pose_covariance_.topLeftCorner<2, 2>() * w);
   if (held_since_ == kNoConstrainedMatch) {
