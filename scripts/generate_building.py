@@ -14,7 +14,8 @@ by a random angle and shifted off any lattice. The family defaults to one of the
 The path is one lap of the ring (through the dead end, the hall, the cross corridors) and on around the
 first side(s) again, so that the SLAM can close the loop on a revisit. Two flavours:
   path_laser.txt   stops, dwells and speed changes only where something along the corridor is in view
-                   (corners, junctions, dead ends); constant speed through every blank stretch
+                   within the laser's 240 degrees, arriving and driving off (corners, junctions); a dead end
+                   is left before its end wall is out of view behind; constant speed through blank stretches
   path_wheels.txt  the same route, plus stops (2-8 s) and speed changes inside the blank stretches, which
                    only wheel odometry can measure
 "Blank": a point of the path from which no corner, door jamb, pillar or piece of furniture is within the
@@ -262,10 +263,15 @@ def visible_features(segs, circles, polygons):
     return np.array(pts)
 
 
-def in_view(p, feats, seg_a, seg_b, rng_range):
-    """Whether any feature lies within range of p with a clear line of sight."""
+def in_view(p, feats, seg_a, seg_b, rng_range, heading=None, half_fov=math.radians(120.0)):
+    """Whether any feature lies within range of p with a clear line of sight and, given the robot's heading,
+    within the laser's field of view (the URG-04LX's 240 degrees: a wall end behind the robot is not seen)."""
     d = np.hypot(feats[:, 0] - p[0], feats[:, 1] - p[1])
-    for q in feats[d <= rng_range]:
+    near = d <= rng_range
+    if heading is not None:
+        bearing = np.arctan2(feats[:, 1] - p[1], feats[:, 0] - p[0]) - heading
+        near &= np.abs(np.arctan2(np.sin(bearing), np.cos(bearing))) <= half_fov
+    for q in feats[near]:
         r = q - p
         e = seg_b - seg_a
         den = r[0] * e[:, 1] - r[1] * e[:, 0]
@@ -277,6 +283,37 @@ def in_view(p, feats, seg_a, seg_b, rng_range):
         if not blocked.any():
             return True
     return False
+
+
+def heading(a, b):
+    return math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def stop_in_view(pts, k, feats, seg_a, seg_b, rng_range):
+    """Whether the laser can observe the stop at waypoint k and the start from it: something in view in
+    the heading the robot arrives in, and in the heading it drives off in (it turns in place between)."""
+    p = np.array(pts[k][:2])
+    if k > 0 and not in_view(p, feats, seg_a, seg_b, rng_range, heading(pts[k - 1], pts[k])):
+        return False
+    return k + 1 == len(pts) or in_view(p, feats, seg_a, seg_b, rng_range, heading(pts[k], pts[k + 1]))
+
+
+def turn_where_in_view(laser, feats, seg_a, seg_b, rng_range, step=0.25):
+    """The laser path's out-and-back legs (a dead end) turn round at the deepest point from which something
+    is in view both arriving and driving off: at the end of a dead end longer than the range the end wall
+    is behind the robot as it starts back, and that start is invisible to the laser."""
+    pts = list(laser)
+    for k in range(1, len(pts) - 1):
+        a, b = pts[k - 1], pts[k]
+        if math.dist(a[:2], pts[k + 1][:2]) > 1e-6 or stop_in_view(pts, k, feats, seg_a, seg_b, rng_range):
+            continue
+        length = math.dist(a[:2], b[:2])
+        for s in np.arange(length - step, 0.0, -step):
+            q = (a[0] + (b[0] - a[0]) * s / length, a[1] + (b[1] - a[1]) * s / length) + tuple(b[2:])
+            if stop_in_view(pts[:k] + [q] + pts[k + 1:], k, feats, seg_a, seg_b, rng_range):
+                pts[k] = q
+                break
+    return pts
 
 
 def blank_intervals(a, b, feats, seg_a, seg_b, rng_range, step=0.25):
@@ -319,9 +356,10 @@ def make_paths(rng, route, feats, seg_a, seg_b, rng_range):
             wheels.append((x, y, rng.uniform(2.0, 8.0), rng.choice(SPEEDS)))
     laser.append((route[-1][0], route[-1][1], 0.0, 0.0))
     wheels.append((route[-1][0], route[-1][1], 0.0, 0.0))
-    # Check: the laser flavour stops only where something is in view.
-    for x, y, _, _ in laser:
-        if not in_view(np.array([x, y]), feats, seg_a, seg_b, rng_range):
+    laser = turn_where_in_view(laser, feats, seg_a, seg_b, rng_range)
+    # Check: the laser flavour stops and starts only where something is in view ahead.
+    for k, (x, y, _, _) in enumerate(laser):
+        if not stop_in_view(laser, k, feats, seg_a, seg_b, rng_range):
             raise RuntimeError("laser-flavour waypoint (%.2f, %.2f) is blank" % (x, y))
     return laser, wheels, blanks
 

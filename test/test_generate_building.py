@@ -1,9 +1,11 @@
 """scripts/generate_building.py and simulate_scans on its plans: the same seed gives the same building;
 the plan is a geometry plan simulate_scans reads; the laser path keeps its stops where something is in
-view while the wheel path also stops in blank stretches; --wheel-odometry adds /wheel_odom without
-changing the scans."""
+view (within the laser's 240 degrees) while the wheel path also stops in blank stretches; --wheel-odometry
+adds /wheel_odom without changing the scans."""
 import filecmp
+import importlib.util
 import json
+import math
 import os
 import subprocess
 import sys
@@ -29,6 +31,13 @@ def waypoints(path):
     return [l.split() for l in open(path) if l.strip() and not l.startswith("#")]
 
 
+def turn_depth(path):
+    """How far an out-and-back leg (the dead end) goes before it turns round (m), or None."""
+    p = [tuple(map(float, w[:2])) for w in waypoints(path)]
+    return next((math.dist(p[k - 1], p[k]) for k in range(1, len(p) - 1) if math.dist(p[k - 1], p[k + 1]) < 1e-5),
+                None)
+
+
 class GenerateBuildingTest(unittest.TestCase):
     def test_same_seed_same_building(self):
         a, b, c = (tempfile.mkdtemp() for _ in range(3))
@@ -52,6 +61,35 @@ class GenerateBuildingTest(unittest.TestCase):
             # The building is turned off the axes: not every wall is horizontal or vertical.
             walls = [list(map(float, l.split()[1:])) for l in open(os.path.join(out, "plan.txt")) if l.startswith("wall")]
             self.assertTrue(any(min(abs(w[2] - w[0]), abs(w[3] - w[1])) > 0.01 for w in walls))
+
+    def test_in_view_only_within_the_field_of_view(self):
+        spec = importlib.util.spec_from_file_location("generate_building", GENERATOR)
+        gen = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(gen)
+        # A dead end along +x, 2 m wide, its end wall at x = 0; the robot at x = 1.5 on the centre line.
+        seg_a = gen.np.array([(0.0, -1.0), (0.0, -1.0), (0.0, 1.0)])
+        seg_b = gen.np.array([(0.0, 1.0), (20.0, -1.0), (20.0, 1.0)])
+        corners = gen.np.array([(0.0, -1.0), (0.0, 1.0)])
+        p = gen.np.array([1.5, 0.0])
+        self.assertTrue(gen.in_view(p, corners, seg_a, seg_b, 5.6))                  # any direction
+        self.assertTrue(gen.in_view(p, corners, seg_a, seg_b, 5.6, math.pi))         # facing the end wall
+        self.assertFalse(gen.in_view(p, corners, seg_a, seg_b, 5.6, 0.0))            # driving off: behind
+        # The corner (0, 1) lies 146.3 deg off the x axis: 116.3 deg off a heading of 30 deg, 126.3 off 20.
+        self.assertTrue(gen.in_view(p, corners, seg_a, seg_b, 5.6, math.radians(30)))
+        self.assertFalse(gen.in_view(p, corners, seg_a, seg_b, 5.6, math.radians(20)))
+        self.assertFalse(gen.in_view(p, corners, seg_a, seg_b, 1.0, math.pi))        # out of range
+
+    def test_laser_path_turns_round_in_a_dead_end_where_the_way_out_is_in_view(self):
+        for seed, short in ((3, True), (8, True), (18, False)):  # dead ends of 13.0, 11.4 and 6.7 m
+            out = tempfile.mkdtemp()
+            meta = generate(seed, out, "deadend")
+            laser, wheels = turn_depth(os.path.join(out, "path_laser.txt")), turn_depth(os.path.join(out, "path_wheels.txt"))
+            self.assertIsNotNone(laser, meta)
+            if short:  # the end wall is behind the robot as it starts back: the laser path turns before the end
+                self.assertLess(laser, wheels - 1.0, meta)
+                self.assertLess(laser, 5.6 + 1.0, meta)
+            else:
+                self.assertAlmostEqual(laser, wheels, places=4)
 
     def test_simulated_with_wheel_odometry(self):
         out = tempfile.mkdtemp()

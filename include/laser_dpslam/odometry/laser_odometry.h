@@ -113,6 +113,9 @@ struct OdometryUpdate {
   MatchResult match;                  ///< its pose and weak_direction are in the matching frame (frameAngle())
   RangeFlow range_flow;               ///< the speed along match.weak_direction from the range flow (range_flow_gain)
   bool range_flow_applied = false;    ///< it (with the previous scan's) refuted the velocity and moved it
+  /// The velocity along match.weak_direction was held (degenerate_hold_time): the pose's variance along it
+  /// grows with the time held.
+  bool velocity_held = false;
   bool wheel_prior = false;           ///< the motion prior was the wheel odometry's (addWheelOdometry)
   bool new_keyframe = false;
   int points_used = 0;
@@ -176,6 +179,9 @@ class LaserOdometry {
   /// velocity_ (and the range flow) after a match `dt` after the last one.
   void updateVelocity(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous, double dt,
                       OdometryUpdate& u);
+  /// Where the velocity was held: the pose's variance along the weak direction grows with the time held,
+  /// as that velocity's error does.
+  void heldCovariance(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u);
   /// velocity_ along a degenerate match's weak direction: held, or moved by the range flow.
   void velocityAlongCorridor(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous,
                              double dt, const Eigen::Vector2d& before, const Eigen::Vector3d& measured,
@@ -197,6 +203,8 @@ class LaserOdometry {
   std::deque<Keyframe> keyframes_;
   static constexpr double kNoConstrainedMatch = -1e300;  ///< constrained_stamp_ when there is nothing to hold
   double constrained_stamp_ = kNoConstrainedMatch;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
+  double held_since_ = kNoConstrainedMatch;  ///< stamp of the first scan of the current hold (none: not holding)
+  double held_start_variance_ = 0.0;  ///< m², the pose's variance along the held direction then
   PreprocessedScan previous_scan_;  ///< the last scan matched (range_flow_gain)
   RangeFlow last_flow_;              ///< the range flow measured with the last scan (invalid: none)
   Eigen::Vector2d last_flow_direction_ = Eigen::Vector2d::Zero();  ///< its direction (the match's weak direction, matching frame)

@@ -32,6 +32,7 @@ void LaserOdometry::reset() {
   rng_.seed(config_.seed);
   scan_count_ = 0;
   constrained_stamp_ = kNoConstrainedMatch;
+  held_since_ = kNoConstrainedMatch;
 }
 
 void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points) {
@@ -60,9 +61,15 @@ constexpr std::size_t kMaxWheelSamples = 8192;
 constexpr double kWheelScaleSigma = 0.05;
 constexpr double kWheelMinSigma = 0.001;  // m
 
-// The covariance of a motion whose component along the unit vector `weak` (translation) is the wheels'
-// (variance `v`) instead of the match's: the match's component along it is projected out.
-Eigen::Matrix3d withWheelsAlong(const Eigen::Matrix3d& c, const Eigen::Vector2d& weak, double v) {
+// σ of a held velocity along a corridor (m/s): kHeldSpeedSigma of the speed plus kHeldMinSpeedSigma. It was
+// smoothed over the constrained matches before the hold; 1-3 % off on the simulated corridors
+// (doc/experiments.md).
+constexpr double kHeldSpeedSigma = 0.02;
+constexpr double kHeldMinSpeedSigma = 0.005;  // m/s
+
+// The covariance of a motion whose component along the unit vector `weak` (translation) has variance `v`
+// (the wheels') instead of the match's: the match's component along it is projected out.
+Eigen::Matrix3d withVarianceAlong(const Eigen::Matrix3d& c, const Eigen::Vector2d& weak, double v) {
   Eigen::Matrix3d p = Eigen::Matrix3d::Identity();
   p.topLeftCorner<2, 2>() -= weak * weak.transpose();
   Eigen::Matrix3d out = p * c * p.transpose();
@@ -189,7 +196,9 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   matchCovariances(previous, u);
   if (dt > 0.0 && dt <= config_.max_prior_gap) {
     updateVelocity(scan, mount, previous, dt, u);
+    heldCovariance(previous, scan.stamp, dt, u);
   } else {
+    held_since_ = kNoConstrainedMatch;
     last_flow_ = RangeFlow();
     velocity_.setZero();
     constrained_stamp_ = kNoConstrainedMatch;  // nothing measured to hold
@@ -286,7 +295,7 @@ void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) 
   if (u.wheel_prior && u.match.degenerate) {
     // The match kept the wheels' motion along its weak direction: that component's error is theirs.
     const double sigma = kWheelScaleSigma * std::hypot(u.delta.x, u.delta.y) + kWheelMinSigma;
-    u.delta_covariance = withWheelsAlong(u.delta_covariance, previous.rotation().transpose() * u.match.weak_direction,
+    u.delta_covariance = withVarianceAlong(u.delta_covariance, previous.rotation().transpose() * u.match.weak_direction,
                                          sigma * sigma);
   }
   // The delta's covariance is the matcher's as it is (the SLAM's proposal follows its direction even where
@@ -299,6 +308,27 @@ void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) 
   Eigen::Matrix3d Ja, Jb;
   composeJacobians(kf.pose, between(kf.pose, pose_), &Ja, &Jb);
   pose_covariance_ = Ja * kf.covariance * Ja.transpose() + u.match.bounded_covariance;
+}
+
+void LaserOdometry::heldCovariance(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u) {
+  if (!u.velocity_held || u.wheel_prior) {
+    held_since_ = kNoConstrainedMatch;
+    return;
+  }
+  // A velocity error is the same at every scan of the hold, so the position's error along the corridor
+  // grows linearly, σ_v·t, not as the root of the keyframes chained since. (The delta keeps the match's
+  // covariance: the held velocity's σ_v·dt there made the SLAM worse on the generated buildings,
+  // doc/experiments.md.)
+  const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
+  const double sigma_v = kHeldSpeedSigma * std::abs(weak.dot(velocity_.head<2>())) + kHeldMinSpeedSigma;
+  const Eigen::Vector2d w = u.match.weak_direction;  // matching frame, as pose_covariance_
+  const double along = w.dot(pose_covariance_.topLeftCorner<2, 2>() * w);
+  if (held_since_ == kNoConstrainedMatch) {
+    held_since_ = stamp - dt;
+    held_start_variance_ = along;
+  }
+  const double grown = held_start_variance_ + std::pow(sigma_v * (stamp - held_since_), 2);
+  if (grown > along) pose_covariance_.topLeftCorner<2, 2>() += (grown - along) * w * w.transpose();
 }
 
 void LaserOdometry::updateVelocity(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous,
@@ -346,6 +376,7 @@ void LaserOdometry::velocityAlongCorridor(const PreprocessedScan& scan, const La
                        std::abs(a_speed - b.speed) <= 3.0 * std::hypot(last_flow_.sigma, b.sigma) &&
                        std::abs(mean - before_w) > 3.0 * sigma + 0.02;
   u.range_flow_applied = refutes;
+  u.velocity_held = hold && !refutes;
   if (refutes) {
     // The speed along the corridor measured against the previous scans, not the local map.
     velocity_.head<2>() += weak * (before_w + config_.range_flow_gain * (mean - before_w) - weak.dot(velocity_.head<2>()));
