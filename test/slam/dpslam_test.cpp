@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <set>
 #include <string>
 
 #include "laser_dpslam/odometry/laser_odometry.h"
@@ -407,12 +408,14 @@ TEST(DpSlam, ExploringShrinksTheProposalNoiseAndRevisitsRestoreIt) {
 // net of the ancestry tree's merging: in a map frame along the room's walls (map_align_to_walls, the default)
 // the updated second lap's count came out negative (−11974 entries against +42 frozen; presumably its
 // re-observations land on the first lap's very cells and the merging outweighs them), so the count compares
-// the two only in the first pose's frame.
+// the two only in the first pose's frame. Thinned free-space writes (free_space_beam_step) tip the updated
+// lap's count negative the same way (−3976 against +113 frozen), so every beam writes its whole path here.
 TEST(DpSlam, RevisitFreezeAddsOnlyNewCellsOnOldGround) {
   const SimRun& run = loopRun();
   auto secondLap = [&](bool freeze, LoopError* err) {
     DpSlamConfig config;
     config.map_align_to_walls = false;
+    config.free_space_beam_step = 1;
     config.revisit_freeze_map = freeze;
     DpSlam slam(config);
     std::size_t entries_at_half = 0, revisits = 0, entries_end = 0;
@@ -560,6 +563,56 @@ TEST(DpSlam, MapAlignToWallsTurnsTheMapFrameToTheFirstScansWalls) {
   const Pose2D ra = between(a.front().pose, a.back().pose), rb = between(b.front().pose, b.back().pose);
   EXPECT_NEAR(std::hypot(ra.x - rb.x, ra.y - rb.y), 0.0, 0.05);
   EXPECT_GT(out_on.on_lattice, out_off.on_lattice + 0.1);
+}
+
+// Thinned free space: every 8th beam writes its whole path, the others from where the beams kept lie more than
+// a cell apart (resolution / (2·level·increment)) and always near their return.
+TEST(DpSlam, FreeSpaceWritesStartWhereTheCoarserBeamsSpreadBeyondACell) {
+  const double inc = 0.00614, res = 0.05;
+  for (long b : {0L, 1L, 5L, 6L, 8L, 100L}) EXPECT_EQ(freeSpaceWriteFrom(b, 1, inc, res), 0.0) << b;
+  EXPECT_EQ(freeSpaceWriteFrom(0, 8, inc, res), 0.0);
+  EXPECT_EQ(freeSpaceWriteFrom(16, 8, inc, res), 0.0);
+  EXPECT_EQ(freeSpaceWriteFrom(-24, 8, inc, res), 0.0);
+  EXPECT_NEAR(freeSpaceWriteFrom(4, 8, inc, res), res / (8 * inc), 1e-12);
+  EXPECT_NEAR(freeSpaceWriteFrom(12, 8, -inc, res), res / (8 * inc), 1e-12);
+  EXPECT_NEAR(freeSpaceWriteFrom(6, 8, inc, res), res / (4 * inc), 1e-12);
+  EXPECT_NEAR(freeSpaceWriteFrom(7, 8, inc, res), res / (2 * inc), 1e-12);
+  EXPECT_EQ(freeSpaceWriteFrom(7, 8, 0.0, res), 0.0);  // unknown increment: no thinning
+}
+
+// With thinning the first scan's map has the same walls and sees the same free space, a few cells short at
+// most where beams diverge past an obstacle; later scans fill those in.
+TEST(DpSlam, ThinnedFreeSpaceWritesMapTheSameCells) {
+  DpSlamConfig full;
+  full.particles = 10;
+  full.free_space_beam_step = 1;
+  DpSlamConfig thin = full;
+  thin.free_space_beam_step = 8;
+  auto cells = [](const OccupancyGridData& m, bool occupied) {
+    std::set<std::pair<long, long>> out;
+    for (int iy = 0; iy < m.height; ++iy) {
+      for (int ix = 0; ix < m.width; ++ix) {
+        const int v = m.at(ix, iy);
+        if (v >= 0 && (v > 50) == occupied) {
+          out.insert({std::lround(m.origin_x / m.resolution) + ix, std::lround(m.origin_y / m.resolution) + iy});
+        }
+      }
+    }
+    return out;
+  };
+  for (std::size_t scans : {std::size_t{1}, std::size_t{30}}) {
+    DpSlam a(full), b(thin);
+    runSlam(full, scans, &a);
+    runSlam(thin, scans, &b);
+    const OccupancyGridData ma = a.bestMap(), mb = b.bestMap();
+    const auto free_a = cells(ma, false), free_b = cells(mb, false);
+    std::size_t missing = 0;
+    for (const auto& c : free_a) missing += free_b.count(c) ? 0 : 1;
+    EXPECT_LT(missing, free_a.size() / 100) << scans << " scans: " << missing << " of " << free_a.size();
+    if (scans == 1) {
+      EXPECT_EQ(cells(ma, true), cells(mb, true));
+    }
+  }
 }
 
 // Either travel threshold works on its own: a distance alone ignores turns in place, an angle alone ignores

@@ -144,6 +144,24 @@ TEST(Proposal, WildOrInvalidCovariancesAreTamed) {
   EXPECT_NEAR(s(1, 1), 1e-4 + 1e-4, 1e-12);
 }
 
+// The noise floor is per scan: a motion composed over n scans (the filter updated by travel) gets n times the
+// floor's variance, as n updates of one scan each would have spread the particles; the rest is unchanged.
+TEST(Proposal, NoiseFloorAddsUpOverTheScansComposed) {
+  ProposalNoise noise;
+  noise.min_sigma_xy = 0.01;
+  noise.min_sigma_theta = 0.005;
+  noise.sigma_xy_per_m = 0.1;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  cov.diagonal() << 4e-4, 1e-4, 1e-5;
+  const Pose2D delta(0.3, 0.0, 0.0);
+  const Eigen::Matrix3d L1 = proposalFactor(delta, cov, noise), L4 = proposalFactor(delta, cov, noise, 4);
+  const Eigen::Matrix3d s1 = L1 * L1.transpose(), s4 = L4 * L4.transpose();
+  EXPECT_NEAR(s4(0, 0) - s1(0, 0), 3 * 1e-4, 1e-12);
+  EXPECT_NEAR(s4(1, 1) - s1(1, 1), 3 * 1e-4, 1e-12);
+  EXPECT_NEAR(s4(2, 2) - s1(2, 2), 3 * 2.5e-5, 1e-12);
+  EXPECT_NEAR(s1(0, 0), 4e-4 + 1e-4 + 9e-4, 1e-12);
+}
+
 TEST(WeightedPoseCovariance, WrapsAnglesAroundPi) {
   const std::vector<Pose2D> poses{Pose2D(0, 0, M_PI - 0.01), Pose2D(2, 0, -M_PI + 0.01)};
   Pose2D mean;

@@ -39,6 +39,8 @@ struct PreprocessedScan {
   std::vector<double> ranges;             ///< m, range of each point
   std::vector<double> angles;             ///< rad, beam angle of each point
   std::vector<double> no_return_angles;   ///< rad, beams that saw nothing up to range_max (+inf or above max)
+  double angle_min = 0.0;                 ///< rad, the scan's beam 0 (beam i is at angle_min + i·angle_increment)
+  double angle_increment = 0.0;           ///< rad; 0 when the scan was not built by preprocessScan
   BeamCounts counts;
   std::string error;                      ///< non-empty: the scan as a whole is malformed, and why
 

@@ -60,6 +60,10 @@ struct DpSlamConfig {
   double no_return_range = 6.0;    ///< m; a no-return beam is free space up to min(this, the scan's range_max)
   double entry_prior_cells = 4.0;  ///< cells of distance a new cell entry starts with (DP-SLAM's prior)
   int update_beam_step = 1;        ///< every k-th beam is written into the map
+  /// a power of two k: every k-th beam writes its whole path; the others write only where the beams of the
+  /// coarser levels (every 2nd, 4th, ... beam) lie more than a cell apart, and near their return (1 = off).
+  /// 8: a fifth less CPU on the URG-04LX, same maps; accuracy in doc/benchmarks.md ("Thinned free space")
+  int free_space_beam_step = 8;
   double free_saturation_distance = 1.0;  ///< m; free cells seen without a hit over this distance are not rewritten (0 = off)
   double map_update_distance = 0.0;  ///< m travelled since the last map update before the next ... (0 = off)
   double map_update_angle = 0.0;     ///< rad turned since the last map update (0 = off; both off = every filter update)
@@ -116,6 +120,11 @@ struct DpSlamUpdate {
 /// each ignored when 0 (either alone works); with both 0, always.
 bool travelThresholdReached(const Pose2D& motion, double distance, double angle);
 
+/// Where beam `beam` of a scan (angle_min + beam·increment) starts writing free space, for
+/// DpSlamConfig::free_space_beam_step = step: 0 for every step-th beam; otherwise from where the beams of
+/// the coarser levels lie more than a cell apart. Every cell is then crossed by some beam, as with all beams.
+double freeSpaceWriteFrom(long beam, int step, double increment, double resolution);
+
 class DpSlam {
  public:
   explicit DpSlam(const DpSlamConfig& config = DpSlamConfig());
@@ -156,6 +165,7 @@ class DpSlam {
     bool no_return;
     double incidence;  ///< |cos| to the surface normal at the return (1: no return / no fit)
     double nx = 0.0, ny = 0.0;  ///< that normal in the base frame ((0, 0): no return / no fit)
+    double write_from = 0.0;    ///< m; the map write starts here (free_space_beam_step)
   };
   /// A pose with its rotation, so that the cosine and sine are computed once per pose, not once per beam.
   struct PoseFrame {
@@ -217,6 +227,7 @@ class DpSlam {
   Pose2D motion_;               ///< all motion given to process() since the first used scan, composed
   std::vector<StampedPose> motion_path_;  ///< motion_ at every pose of the particles' paths
   Eigen::Matrix3d pending_cov_ = Eigen::Matrix3d::Zero();
+  int pending_scans_ = 0;  ///< scans whose motion pending_ composes (the proposal's noise floor is per scan)
   Pose2D since_map_update_;     ///< filter motion since the last map update
   bool force_map_update_ = false;
 

@@ -81,6 +81,9 @@ struct MapBeam {
   bool no_return = false;     ///< free space up to `range`, nothing hit
   double incidence = 1.0;     ///< |cos| of the angle to the normal of the surface hit (see setSurfaceDepth)
   double nx = 0.0, ny = 0.0;  ///< unit normal of the surface hit (sign arbitrary); (0, 0) = unknown (setCellNormals)
+  /// m; planBeam writes from here on (the last two cells before a return always): the free space nearer the
+  /// laser is written by beams that start nearer, spaced at most a cell apart
+  double write_from = 0.0;
 };
 
 class DpSlamMap;

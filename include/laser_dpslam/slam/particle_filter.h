@@ -45,7 +45,8 @@ struct ProposalNoise {
   double max_sigma_xy = 0.1;      ///< m, cap of the scan matcher's translation standard deviation
   double max_sigma_theta = 0.1;   ///< rad, cap of the scan matcher's rotation standard deviation
 };
-Eigen::Matrix3d proposalFactor(const Pose2D& delta, const Eigen::Matrix3d& delta_cov, const ProposalNoise& noise);
+Eigen::Matrix3d proposalFactor(const Pose2D& delta, const Eigen::Matrix3d& delta_cov, const ProposalNoise& noise,
+                               int scans = 1);
 
 /// One draw of the motion: delta + L·n (n ~ N(0, I)), to be applied in the particle's own frame.
 Pose2D sampleMotion(const Pose2D& delta, const Eigen::Matrix3d& L, GaussianSampler& rng);

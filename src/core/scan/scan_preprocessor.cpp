@@ -137,6 +137,8 @@ PreprocessedScan preprocessScan(const LaserScan& scan, const ScanPreprocessorCon
   const float lo_f = static_cast<float>(std::clamp(lo, -kFloatMax, kFloatMax));
   const float hi_f = static_cast<float>(std::min(hi, kFloatMax));
   out.range_max = std::max(hi, static_cast<double>(hi_f));
+  out.angle_min = scan.angle_min;
+  out.angle_increment = scan.angle_increment;
   classifyBeams(scan, config, lo_f, hi_f, out);
   return out;
 }

@@ -19,6 +19,15 @@ bool travelThresholdReached(const Pose2D& motion, double distance, double angle)
          (angle > 0.0 && std::abs(motion.theta) >= angle);
 }
 
+double freeSpaceWriteFrom(long beam, int step, double increment, double resolution) {
+  if (step <= 1 || !(std::abs(increment) > 0.0)) return 0.0;
+  // The beam's level: the largest power of two dividing its index (capped at step). The beams of the
+  // levels above lie 2·level increments apart, more than a cell from resolution / (2·level·increment) on.
+  const unsigned long u = static_cast<unsigned long>(beam < 0 ? -beam : beam);
+  const unsigned long level = u == 0 ? static_cast<unsigned long>(step) : (u & (~u + 1));
+  if (level >= static_cast<unsigned long>(step)) return 0.0;
+  return resolution / (2.0 * static_cast<double>(level) * std::abs(increment));
+}
 
 namespace {
 void require(bool ok, const char* what) {
@@ -45,6 +54,8 @@ void DpSlamConfig::validate() const {
   require(no_return_range > 0.0, "no_return_range must be > 0");
   require(entry_prior_cells > 0.0, "entry_prior_cells must be > 0");
   require(update_beam_step >= 1 && score_beam_step >= 1, "beam steps must be >= 1");
+  require(free_space_beam_step >= 1 && (free_space_beam_step & (free_space_beam_step - 1)) == 0,
+          "free_space_beam_step must be a power of two");
   require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
   require(surface_depth >= 0.0, "surface_depth must be >= 0");
   require(surface_min_cos > 0.0 && surface_min_cos <= 1.0, "surface_min_cos must be in (0, 1]");
@@ -90,6 +101,7 @@ void DpSlam::reset() {
   last_neff_ = 0.0;
   pending_ = Pose2D();
   pending_cov_.setZero();
+  pending_scans_ = 0;
   motion_ = Pose2D();
   motion_path_.clear();
   since_map_update_ = Pose2D();
@@ -118,6 +130,9 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
     const Eigen::Vector2d d = mount.A * Eigen::Vector2d(std::cos(a), std::sin(a));
     const double n = d.norm();
     BaseBeam b{d.x() / n, d.y() / n, 0.0, !take_return, 1.0};
+    const long index = take_return ? scan.beams[i]
+                                   : (scan.angle_increment != 0.0 ? std::lround((a - scan.angle_min) / scan.angle_increment) : 0);
+    b.write_from = freeSpaceWriteFrom(index, config_.free_space_beam_step, scan.angle_increment, config_.map_resolution);
     if (take_return) {
       if (!fits.incidence.empty()) {
         if (config_.surface_depth > 0.0) b.incidence = fits.incidence[i];
@@ -157,6 +172,7 @@ MapBeam DpSlam::toMap(const PoseFrame& f, const BaseBeam& b) const {
   m.incidence = b.incidence;
   m.nx = c * b.nx - s * b.ny;
   m.ny = s * b.nx + c * b.ny;
+  m.write_from = b.write_from;
   return m;
 }
 
@@ -283,6 +299,7 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
   }
 
   composeMotion(pending_, pending_cov_, delta, delta_cov);
+  ++pending_scans_;
   motion_ = motion_ * delta;
   const bool moved_enough = travelThresholdReached(pending_, config_.min_travel_distance, config_.min_travel_angle);
   if (!usable || !moved_enough) {
@@ -325,6 +342,7 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
   last_neff_ = resample ? P : nw.neff;
   pending_ = Pose2D();
   pending_cov_.setZero();
+  pending_scans_ = 0;
   record(stamp);
   u.filter_updated = true;
   u.resampled = resample;
@@ -333,7 +351,7 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
 void DpSlam::propose(const Pose2D& delta, const Eigen::Matrix3d& cov, std::vector<Pose2D>& chosen,
                      std::vector<double>& ll) {
   // 1. Proposal: each particle moves by the delta plus noise, in its own frame. Draws in a fixed order.
-  Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal);
+  Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal, std::max(1, pending_scans_));
   // Exploring, the noise mostly random-walks the particles (their fresh maps move with them); back on old
   // ground it is what lets the filter find the older map's alignment (doc/benchmarks.md).
   const Pose2D ahead = poses_[best_] * delta;

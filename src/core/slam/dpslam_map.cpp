@@ -630,8 +630,10 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   // setCellNormals: the cell the beam stops in takes the normal of the surface it hit.
   const bool normals = cell_normal_min_cos_ > 0.0;
   const int beam_normal = normals && hit ? quantizeNormal(b.nx, b.ny) : 0;
+  const double near_end = hit ? length - 2.0 * resolution_ : length;  // every beam writes its last two cells
+  const double from = std::max(0.0, std::min(b.write_from, near_end));
   Cursor cur;
-  traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, length, resolution_, [&](int ix, int iy, double t0, double t1) {
+  traceCells(b.ox, b.oy, b.dx, b.dy, from, length, resolution_, [&](int ix, int iy, double t0, double t1) {
     const bool end = hit && t1 >= length;
     int q = 0;  // the cell's normal, if it has statistics
     if ((normals || !end || only_unknown) && seek(cur, ix, iy, cache)) {

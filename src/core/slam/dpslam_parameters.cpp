@@ -108,6 +108,9 @@ std::vector<Parameter<S>> mapEntries() {
        "distance a new cell entry starts with, as if already crossed without a stop", kAdvanced},
       {"update_beam_step", "map", FIELD(slam.update_beam_step), "beams", atLeast(1),
        "every k-th beam is written into the map", kAdvanced},
+      {"free_space_beam_step", "map", FIELD(slam.free_space_beam_step), "beams", atLeast(1),
+       "a power of two k: every k-th beam writes its whole path, the others only where the beams kept lie more "
+       "than a cell apart (and their last two cells); 1 = every beam writes its whole path", kAdvanced},
       {"free_saturation_distance", "map", FIELD(slam.free_saturation_distance), "m", atLeast(0),
        "a free cell already crossed this far without a stop is not rewritten; 0 = off", kAdvanced},
       {"map_update_distance", "map", FIELD(slam.map_update_distance), "m", atLeast(0),

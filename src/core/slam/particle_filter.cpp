@@ -24,7 +24,7 @@ double GaussianSampler::normal() {
   return r * std::cos(2.0 * M_PI * u2);
 }
 
-Eigen::Matrix3d proposalFactor(const Pose2D& delta, const Eigen::Matrix3d& delta_cov, const ProposalNoise& n) {
+Eigen::Matrix3d proposalFactor(const Pose2D& delta, const Eigen::Matrix3d& delta_cov, const ProposalNoise& n, int scans) {
   Eigen::Matrix3d cov = 0.5 * (delta_cov + delta_cov.transpose());
   bool ok = cov.allFinite();
   if (ok) {
@@ -45,10 +45,10 @@ Eigen::Matrix3d proposalFactor(const Pose2D& delta, const Eigen::Matrix3d& delta
     if (sd > cap) f(i) = cap / sd;
   }
   sigma = f.asDiagonal() * sigma * f.asDiagonal();
-  const double sxy = n.min_sigma_xy * n.min_sigma_xy + std::pow(n.sigma_xy_per_m * t, 2);
+  const double sxy = scans * n.min_sigma_xy * n.min_sigma_xy + std::pow(n.sigma_xy_per_m * t, 2);
   sigma(0, 0) += sxy;
   sigma(1, 1) += sxy;
-  sigma(2, 2) += n.min_sigma_theta * n.min_sigma_theta + std::pow(n.sigma_theta_per_rad * r, 2);
+  sigma(2, 2) += scans * n.min_sigma_theta * n.min_sigma_theta + std::pow(n.sigma_theta_per_rad * r, 2);
   Eigen::LLT<Eigen::Matrix3d> llt(sigma);
   if (llt.info() == Eigen::Success) return llt.matrixL();
   Eigen::Matrix3d diag = Eigen::Matrix3d::Zero();
