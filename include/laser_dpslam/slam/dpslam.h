@@ -80,6 +80,9 @@ struct DpSlamConfig {
   // --- Observation model ---
   BeamModelConfig beam;         ///< sigma, window, log floor, unknown mean free path
   int score_beam_step = 4;      ///< every k-th beam is scored (tempering and speed)
+  /// every k-th beam enters the cheap score that picks among the over-sampled candidates (8: half the scored
+  /// beams are enough to rank a particle's candidates; doc/benchmarks.md, "Thinned free space")
+  int cull_beam_step = 8;
   double likelihood_weight = 0.5;  ///< exponent of a scan's likelihood in the weights (tempering, 0–1]
   bool score_no_return = true;  ///< no-return beams are scored too (free space up to the range)
   int min_points = 20;          ///< fewer valid returns: the scan is not used (particles still move)
@@ -113,6 +116,7 @@ struct DpSlamUpdate {
   bool revisit = false;          ///< the filter update saw the robot on old ground (full proposal noise)
   std::size_t tree_nodes = 0;
   std::size_t map_entries = 0;
+  std::size_t map_writes = 0;    ///< cell writes this update planned (0 when the map was not updated)
   std::size_t memory_bytes = 0;  ///< map + caches
 };
 
@@ -233,7 +237,7 @@ class DpSlam {
 
   Eigen::Vector2d beam_origin_ = Eigen::Vector2d::Zero();  ///< laser position in the base frame
 
-  std::vector<BaseBeam> score_beams_, update_beams_;
+  std::vector<BaseBeam> score_beams_, cull_beams_, update_beams_;
   RevisitDetector revisit_;      ///< on the best particle's path: exploring or revisiting
   bool last_revisit_ = false;
 };

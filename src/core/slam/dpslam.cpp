@@ -53,7 +53,7 @@ void DpSlamConfig::validate() const {
   require(trace_max_range > map_resolution, "trace_max_range must exceed map_resolution");
   require(no_return_range > 0.0, "no_return_range must be > 0");
   require(entry_prior_cells > 0.0, "entry_prior_cells must be > 0");
-  require(update_beam_step >= 1 && score_beam_step >= 1, "beam steps must be >= 1");
+  require(update_beam_step >= 1 && score_beam_step >= 1 && cull_beam_step >= 1, "beam steps must be >= 1");
   require(free_space_beam_step >= 1 && (free_space_beam_step & (free_space_beam_step - 1)) == 0,
           "free_space_beam_step must be a power of two");
   require(free_saturation_distance >= 0.0, "free_saturation_distance must be >= 0");
@@ -149,6 +149,7 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
     all.push_back(b);
   }
   score_beams_.clear();
+  cull_beams_.clear();
   update_beams_.clear();
   for (std::size_t k = 0; k < all.size(); ++k) {
     BaseBeam b = all[k];
@@ -156,6 +157,7 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
     if (scored_out) b.range = no_return_range;
     if (k % static_cast<std::size_t>(config_.update_beam_step) == 0) update_beams_.push_back(b);
     if (!scored_out && k % static_cast<std::size_t>(config_.score_beam_step) == 0) score_beams_.push_back(b);
+    if (!scored_out && k % static_cast<std::size_t>(config_.cull_beam_step) == 0) cull_beams_.push_back(b);
   }
 }
 
@@ -211,7 +213,7 @@ void DpSlam::scoreAll(const std::vector<Pose2D>& chosen, std::vector<double>& ll
 void DpSlam::cheapScoreAll(const std::vector<Pose2D>& candidates, int per_slot, std::vector<double>& cheap) {
   std::vector<PoseFrame> frames(candidates.begin(), candidates.end());
   std::fill(cheap.begin(), cheap.end(), 0.0);
-  forEachBeamByBlock(candidates.size(), score_beams_, [&](std::size_t n, const BaseBeam& b, LookupCache& cache) {
+  forEachBeamByBlock(candidates.size(), cull_beams_, [&](std::size_t n, const BaseBeam& b, LookupCache& cache) {
     if (b.no_return || b.range >= config_.trace_max_range) return;
     cheap[n] += map_.beamEndpointLogLikelihood(toMap(frames[n], b), config_.cull_window, static_cast<int>(n) / per_slot,
                                                cache, config_.beam);
@@ -407,6 +409,7 @@ void DpSlam::updateMapAndTree(const Pose2D& delta, const std::vector<int>& paren
   if (due) {
     std::vector<int> nodes;
     for (int i : survivors) nodes.push_back(lineage[i]);
+    for (int i : survivors) u.map_writes += writes_[i].size();
     applyWrites(survivors, nodes);
     since_map_update_ = Pose2D();
     u.map_updated = true;

@@ -149,6 +149,8 @@ std::vector<Parameter<S>> observationAndOutputEntries() {
        "an unobserved cell stops beams with density 1/this", kAdvanced},
       {"score_beam_step", "observation model", FIELD(slam.score_beam_step), "beams", atLeast(1),
        "every k-th beam is scored (tempering and speed)", kAdvanced},
+      {"cull_beam_step", "observation model", FIELD(slam.cull_beam_step), "beams", atLeast(1),
+       "every k-th beam enters the cheap score that picks each particle's candidate (oversampling)", kAdvanced},
       {"likelihood_weight", "observation model", FIELD(slam.likelihood_weight), "-", leftOpenInterval(0, 1),
        "exponent of a scan's likelihood in the particle weights (tempering)", kAdvanced},
       {"score_no_return", "observation model", FIELD(slam.score_no_return), "bool", anyValue(),
