@@ -408,8 +408,10 @@ void DpSlam::updateMapAndTree(const Pose2D& delta, const std::vector<int>& paren
   leaves_ = tree_.advance(leaves_, parents, ++generation_, map_, &lineage);
   if (due) {
     std::vector<int> nodes;
-    for (int i : survivors) nodes.push_back(lineage[i]);
-    for (int i : survivors) u.map_writes += writes_[i].size();
+    for (int i : survivors) {
+      nodes.push_back(lineage[i]);
+      u.map_writes += writes_[i].size();
+    }
     applyWrites(survivors, nodes);
     since_map_update_ = Pose2D();
     u.map_updated = true;
