@@ -421,6 +421,13 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
   EXPECT_EQ(DpSlamMap::quantizeNormal(0.0, 0.0), 0);
   EXPECT_EQ(DpSlamMap::quantizeNormal(1.0, 0.0), DpSlamMap::quantizeNormal(-1.0, 0.0));  // sign does not matter
   EXPECT_EQ(DpSlamMap::quantizeNormal(0.0, 1.0), 128);
+  // From the normal's direction (the scan's angle plus the pose's heading, any number of turns) alike.
+  for (int k = -40; k <= 40; ++k) {
+    const double a = 0.173 * k;
+    const int q = DpSlamMap::quantizeNormal(std::cos(a), std::sin(a));
+    for (int turns = -2; turns <= 2; ++turns) EXPECT_EQ(DpSlamMap::quantizeNormalAngle(a + turns * M_PI), q) << a;
+  }
+  EXPECT_EQ(DpSlamMap::quantizeNormalAngle(0.25 * M_PI), DpSlamMap::quantizeNormal(1.0, 1.0));
   AncestryTree tree;
   const int root = tree.createRoot();
   // A wall across row 0 at x = 1.0: head-on returns (normal along x) stop in cell (10, 0).

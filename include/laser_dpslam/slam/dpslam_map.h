@@ -81,6 +81,9 @@ struct MapBeam {
   bool no_return = false;     ///< free space up to `range`, nothing hit
   double incidence = 1.0;     ///< |cos| of the angle to the normal of the surface hit (see setSurfaceDepth)
   double nx = 0.0, ny = 0.0;  ///< unit normal of the surface hit (sign arbitrary); (0, 0) = unknown (setCellNormals)
+  /// rad, that normal's direction when known without an atan2 (the base frame's plus the pose's heading);
+  /// NaN = take it from (nx, ny)
+  double normal_angle = std::numeric_limits<double>::quiet_NaN();
   /// m; planBeam writes from here on (the last two cells before a return always): the free space nearer the
   /// laser is written by beams that start nearer, spaced at most a cell apart
   double write_from = 0.0;
@@ -177,6 +180,7 @@ class DpSlamMap : public AncestryHooks {
   double offsetValue(int k) const { return (k - 128) * (0.75 * resolution_ / 127.0); }
   /// A quantised normal (MapEntry::normal): 0 = none, else k in 1..255 for the angle (k − ½)·π/255.
   static int quantizeNormal(double nx, double ny);  ///< 0 for (0, 0)
+  static int quantizeNormalAngle(double a);         ///< the same for the normal's direction a (rad)
   /// Node IDs above this do not fit MapEntry::owner (DpSlamConfig caps particles well below it).
   static constexpr int kMaxNodeId = 32767;
   int cellIndex(double v) const { return static_cast<int>(std::floor(v / resolution_)); }

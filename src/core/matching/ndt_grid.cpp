@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "laser_dpslam/common/fast_exp.h"
+
 namespace laser_dpslam {
 
 namespace {
@@ -91,7 +93,7 @@ double NdtGrid::density(const Eigen::Vector2d& p) const {
     const NdtCell* c = layer.cellAt(p, inv);
     if (!c) continue;
     const Eigen::Vector2d q = p - c->mean;
-    s += c->weight * std::exp(-0.5 * q.dot(c->information * q));
+    s += c->weight * negExp(0.5 * q.dot(c->information * q));
   }
   return s;
 }
@@ -121,7 +123,7 @@ NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& 
       const double m2 = qx * iqx + qy * iqy;
       if (m2 < 9.0) matched = true;
       if (m2 > 40.0) continue;  // exp(−20) ≈ 2e-9: no contribution worth an exp()
-      const double e = cell->weight * std::exp(-0.5 * m2);
+      const double e = cell->weight * negExp(0.5 * m2);
       h -= e;
       if (!derivatives) continue;
       // g_k = e·qᵀΣ⁻¹J_k with J = [e_x, e_y, j_θ].

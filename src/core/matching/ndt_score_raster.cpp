@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "laser_dpslam/common/fast_exp.h"
+
 namespace laser_dpslam {
 
 void NdtScoreRaster::build(const NdtGrid& grid, double resolution) {
@@ -43,7 +45,7 @@ void NdtScoreRaster::build(const NdtGrid& grid, double resolution) {
           for (int ix = ix0; ix <= ix1; ++ix) {
             const double qx = origin_.x() + ix * resolution_ - cell.mean.x();
             const double m2 = a * qx * qx + 2.0 * b * qx * qy + c * qy * qy;
-            if (m2 < 50.0) row[ix] += static_cast<float>(cell.weight * std::exp(-0.5 * m2));
+            if (m2 < 50.0) row[ix] += static_cast<float>(cell.weight * negExp(0.5 * m2));
           }
         }
       }

@@ -139,6 +139,7 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
         const Eigen::Vector2d nb = mount.A * fits.normals[i];
         b.nx = nb.x();
         b.ny = nb.y();
+        b.normal_angle = std::atan2(b.ny, b.nx);
       }
       b.range = scan.ranges[i++];
     } else {
@@ -174,6 +175,7 @@ MapBeam DpSlam::toMap(const PoseFrame& f, const BaseBeam& b) const {
   m.incidence = b.incidence;
   m.nx = c * b.nx - s * b.ny;
   m.ny = s * b.nx + c * b.ny;
+  if (b.nx != 0.0 || b.ny != 0.0) m.normal_angle = b.normal_angle + pose.theta;
   m.write_from = b.write_from;
   return m;
 }

@@ -9,6 +9,8 @@
 
 #include <sys/mman.h>
 
+#include "laser_dpslam/common/fast_exp.h"
+
 namespace laser_dpslam {
 
 static_assert(sizeof(MapEntry) == 16, "MapEntry grew: the map's memory is mostly entries");
@@ -545,7 +547,11 @@ const MapEntry* DpSlamMap::cachedLookup(int ix, int iy, int slot, LookupCache& c
 
 int DpSlamMap::quantizeNormal(double nx, double ny) {
   if (nx == 0.0 && ny == 0.0) return 0;
-  double a = std::atan2(ny, nx);  // a normal's sign does not matter: angle modulo π
+  return quantizeNormalAngle(std::atan2(ny, nx));
+}
+
+int DpSlamMap::quantizeNormalAngle(double a) {
+  a = std::fmod(a, M_PI);  // a normal's sign does not matter: angle modulo π
   if (a < 0.0) a += M_PI;
   if (a >= M_PI) a -= M_PI;
   return std::min(255, 1 + static_cast<int>(a * (255.0 / M_PI)));
@@ -629,7 +635,8 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   const double surface_from = hit && surface_depth_ > 0.0 ? length - surface_depth_ : length + 1.0;
   // setCellNormals: the cell the beam stops in takes the normal of the surface it hit.
   const bool normals = cell_normal_min_cos_ > 0.0;
-  const int beam_normal = normals && hit ? quantizeNormal(b.nx, b.ny) : 0;
+  const int beam_normal =
+      !(normals && hit) ? 0 : (std::isnan(b.normal_angle) ? quantizeNormal(b.nx, b.ny) : quantizeNormalAngle(b.normal_angle));
   const double near_end = hit ? length - 2.0 * resolution_ : length;  // every beam writes its last two cells
   const double from = std::max(0.0, std::min(b.write_from, near_end));
   Cursor cur;
@@ -747,17 +754,17 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
       return true;
     }
     if (!in_window) {
-      reach = std::exp(-tau);
+      reach = negExp(tau);
       in_window = true;
     }
-    const double pass = std::exp(-mu * d);
+    const double pass = negExp(mu * d);
     const double stop = reach * (1.0 - pass);
     reach *= pass;
     const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
-    if (std::abs(e) < m.window) eval += stop * std::exp(-e * e * inv_2s2);
+    if (std::abs(e) < m.window) eval += stop * negExp(e * e * inv_2s2);
     return reach > 1e-9;  // nothing left to explain: stop tracing
   });
-  if (!in_window) reach = std::exp(-tau);
+  if (!in_window) reach = negExp(tau);
   const double value = no_return ? eval + reach : (reach < 1.0 ? eval / (1.0 - reach) : 0.0);
   return value > 0.0 ? std::max(std::log(value), m.log_floor) : m.log_floor;
 }
@@ -785,11 +792,11 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                }
                if (mu == 0.0) return true;
                const double d = (t1 - t0) * chordFactor(q, b, std::abs(0.5 * (t0 + t1) - z) < surface_depth_);
-               const double pass = std::exp(-mu * d);
+               const double pass = negExp(mu * d);
                const double stop = reach * (1.0 - pass);
                reach *= pass;
                const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
-               eval += stop * std::exp(-e * e * inv_2s2);
+               eval += stop * negExp(e * e * inv_2s2);
                return reach > 1e-9;
              });
   const double value = reach < 1.0 ? eval / (1.0 - reach) : 0.0;
