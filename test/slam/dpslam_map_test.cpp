@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 
@@ -428,6 +429,7 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
     for (int turns = -2; turns <= 2; ++turns) EXPECT_EQ(DpSlamMap::quantizeNormalAngle(a + turns * M_PI), q) << a;
   }
   EXPECT_EQ(DpSlamMap::quantizeNormalAngle(0.25 * M_PI), DpSlamMap::quantizeNormal(1.0, 1.0));
+  EXPECT_EQ(DpSlamMap::quantizeNormalAngle(std::numeric_limits<double>::quiet_NaN()), 0);
   AncestryTree tree;
   const int root = tree.createRoot();
   // A wall across row 0 at x = 1.0: head-on returns (normal along x) stop in cell (10, 0).
@@ -438,7 +440,7 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
       b.ox = 0.05;
       b.oy = 0.05;
       b.range = 0.97 + 0.01 * k;  // ends at x 1.02 .. 1.11
-      b.nx = 1.0;
+      b.normal_angle = 0.0;
       map.addBeam(b, 20.0, 0, root, cache);
     }
   };
@@ -481,8 +483,7 @@ TEST(DpSlamMap, CellNormalsCountDistanceAlongTheStoredNormal) {
   for (int k = 0; k < 5; ++k) {
     g.no_return = false;
     g.range = 1.48 + 0.01 * k;
-    g.nx = 0.0;
-    g.ny = 1.0;
+    g.normal_angle = 0.5 * M_PI;
     on.addBeam(g, 20.0, 0, root, c_on);
     off.addBeam(g, 20.0, 0, root, c_off);
   }
@@ -508,7 +509,7 @@ TEST(DpSlamMap, SurfaceOffsetsScoreAStopWhereTheWallIsInsideItsCell) {
     cache.begin(tree, {root});
     for (int k = 0; k < 3; ++k) {
       MapBeam b = OneLineage::alongX(0.05, 0.96 + 0.01 * k);
-      b.nx = (k == 1 ? -1.0 : 1.0);  // a normal's sign does not matter
+      b.normal_angle = (k == 1 ? M_PI : 0.0);  // a normal's sign does not matter
       map.addBeam(b, 20.0, 0, root, cache);
     }
   };
@@ -546,7 +547,7 @@ TEST(DpSlamMap, SurfaceOffsetsScoreAStopWhereTheWallIsInsideItsCell) {
   const auto kids = tree.advance({root}, {0, 0}, 1, on);
   c_on.begin(tree, kids);
   MapBeam far = OneLineage::alongX(0.05, 1.02);  // ends at x 1.07: offset +0.02 from the centre
-  far.nx = 1.0;
+  far.normal_angle = 0.0;
   for (int k = 0; k < 4; ++k) on.addBeam(far, 20.0, 0, kids[0], c_on);
   const MapEntry* child = on.lookup(10, 0, kids[0], tree);
   ASSERT_EQ(child->owner, kids[0]);
@@ -571,14 +572,13 @@ TEST(DpSlamMap, CellNormalsBelongToTheLineageThatWroteThem) {
   along_x.ox = 0.05;
   along_x.oy = 0.05;
   along_x.range = 1.0;
-  along_x.nx = 1.0;
+  along_x.normal_angle = 0.0;
   MapBeam along_y = along_x;  // from the south: ends in the same cell on a face with its normal along y
   along_y.ox = 1.05;
   along_y.oy = -0.95;
   along_y.dx = 0.0;
   along_y.dy = 1.0;
-  along_y.nx = 0.0;
-  along_y.ny = 1.0;
+  along_y.normal_angle = 0.5 * M_PI;
   for (int k = 0; k < 5; ++k) {
     map.addBeam(along_x, 20.0, 0, kids[0], cache);
     map.addBeam(along_y, 20.0, 1, kids[1], cache);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -168,8 +169,9 @@ class DpSlam {
     double range;   ///< m
     bool no_return;
     double incidence;  ///< |cos| to the surface normal at the return (1: no return / no fit)
-    double nx = 0.0, ny = 0.0;  ///< that normal in the base frame ((0, 0): no return / no fit)
-    double normal_angle = 0.0;  ///< rad, its direction (computed once per scan: an atan2 per particle costs 3 %)
+    /// rad, that normal's direction in the base frame (NaN: no return / no fit); an angle, so that a pose
+    /// only adds its heading (an atan2 per beam and particle cost 3 % of the CPU)
+    double normal_angle = std::numeric_limits<double>::quiet_NaN();
     double write_from = 0.0;    ///< m; the map write starts here (free_space_beam_step)
   };
   /// A pose with its rotation, so that the cosine and sine are computed once per pose, not once per beam.

@@ -80,9 +80,8 @@ struct MapBeam {
   double range = 0.0;         ///< m, measured range (for a no-return beam: the tracing cap)
   bool no_return = false;     ///< free space up to `range`, nothing hit
   double incidence = 1.0;     ///< |cos| of the angle to the normal of the surface hit (see setSurfaceDepth)
-  double nx = 0.0, ny = 0.0;  ///< unit normal of the surface hit (sign arbitrary); (0, 0) = unknown (setCellNormals)
-  /// rad, that normal's direction when known without an atan2 (the base frame's plus the pose's heading);
-  /// NaN = take it from (nx, ny)
+  /// rad, direction of the normal of the surface hit (modulo π: its sign does not matter); NaN = unknown
+  /// (setCellNormals). An angle, not a vector: the scan's angle plus the pose's heading, no atan2 per particle
   double normal_angle = std::numeric_limits<double>::quiet_NaN();
   /// m; planBeam writes from here on (the last two cells before a return always): the free space nearer the
   /// laser is written by beams that start nearer, spaced at most a cell apart
@@ -180,7 +179,7 @@ class DpSlamMap : public AncestryHooks {
   double offsetValue(int k) const { return (k - 128) * (0.75 * resolution_ / 127.0); }
   /// A quantised normal (MapEntry::normal): 0 = none, else k in 1..255 for the angle (k − ½)·π/255.
   static int quantizeNormal(double nx, double ny);  ///< 0 for (0, 0)
-  static int quantizeNormalAngle(double a);         ///< the same for the normal's direction a (rad)
+  static int quantizeNormalAngle(double a);         ///< the same for the normal's direction a (rad); 0 for NaN
   /// Node IDs above this do not fit MapEntry::owner (DpSlamConfig caps particles well below it).
   static constexpr int kMaxNodeId = 32767;
   int cellIndex(double v) const { return static_cast<int>(std::floor(v / resolution_)); }

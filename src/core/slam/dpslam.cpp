@@ -137,9 +137,7 @@ void DpSlam::makeBeams(const PreprocessedScan& scan, const LaserMount& mount) {
       if (!fits.incidence.empty()) {
         if (config_.surface_depth > 0.0) b.incidence = fits.incidence[i];
         const Eigen::Vector2d nb = mount.A * fits.normals[i];
-        b.nx = nb.x();
-        b.ny = nb.y();
-        b.normal_angle = std::atan2(b.ny, b.nx);
+        if (nb.x() != 0.0 || nb.y() != 0.0) b.normal_angle = std::atan2(nb.y(), nb.x());
       }
       b.range = scan.ranges[i++];
     } else {
@@ -173,9 +171,7 @@ MapBeam DpSlam::toMap(const PoseFrame& f, const BaseBeam& b) const {
   m.range = b.range;
   m.no_return = b.no_return;
   m.incidence = b.incidence;
-  m.nx = c * b.nx - s * b.ny;
-  m.ny = s * b.nx + c * b.ny;
-  if (b.nx != 0.0 || b.ny != 0.0) m.normal_angle = b.normal_angle + pose.theta;
+  m.normal_angle = b.normal_angle + pose.theta;  // NaN stays NaN
   m.write_from = b.write_from;
   return m;
 }

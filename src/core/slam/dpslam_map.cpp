@@ -551,6 +551,7 @@ int DpSlamMap::quantizeNormal(double nx, double ny) {
 }
 
 int DpSlamMap::quantizeNormalAngle(double a) {
+  if (std::isnan(a)) return 0;
   a = std::fmod(a, M_PI);  // a normal's sign does not matter: angle modulo π
   if (a < 0.0) a += M_PI;
   if (a >= M_PI) a -= M_PI;
@@ -635,8 +636,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   const double surface_from = hit && surface_depth_ > 0.0 ? length - surface_depth_ : length + 1.0;
   // setCellNormals: the cell the beam stops in takes the normal of the surface it hit.
   const bool normals = cell_normal_min_cos_ > 0.0;
-  const int beam_normal =
-      !(normals && hit) ? 0 : (std::isnan(b.normal_angle) ? quantizeNormal(b.nx, b.ny) : quantizeNormalAngle(b.normal_angle));
+  const int beam_normal = normals && hit ? quantizeNormalAngle(b.normal_angle) : 0;
   const double near_end = hit ? length - 2.0 * resolution_ : length;  // every beam writes its last two cells
   const double from = std::max(0.0, std::min(b.write_from, near_end));
   Cursor cur;
