@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <random>
 
 using namespace laser_dpslam;
@@ -164,4 +165,54 @@ TEST(NdtGrid, PointSigmaWeightEqualisesTheExpectedScoreOfNoisyPoints) {
   }
   EXPECT_GT(thin, 0);
   EXPECT_GT(fat, 0);
+}
+
+namespace {
+// A straight wall along x at y = 1 from x = −3 m on, seen by a laser at (x0, 0) with range 5 m: returns every
+// 2 cm from the wall's end up to where the range ends (x0 + √24 ≈ x0 + 4.9 m).
+std::vector<Eigen::Vector2d> wallSeenFrom(double x0) {
+  std::vector<Eigen::Vector2d> pts;
+  for (double x = -3.0; x <= x0 + 6.0; x += 0.02) {
+    if (std::hypot(x - x0, 1.0) <= 5.0) pts.emplace_back(x, 1.0);
+  }
+  return pts;
+}
+}  // namespace
+
+// The wall seen from x = 0 ends where the range did. A scan of it from 0.2 m farther along reaches 0.2 m
+// past that end: the plain NDT's last cells, holding only part of their wall, pull it back along the wall
+// (a corridor's along-track loss); with the view the cells cut by the range keep no information along
+// their line, and the pull all but vanishes. Cells the view saw whole are untouched.
+TEST(NdtGrid, CellsCutByTheRangeDoNotPullAlongTheirWall) {
+  NdtGridConfig c;
+  c.cell_size = 0.5;
+  const std::vector<Eigen::Vector2d> map = wallSeenFrom(0.0);
+  std::vector<Eigen::Vector2d> scan;  // in the scan's frame, which sits at (0.2, 0) in the map
+  for (const auto& p : wallSeenFrom(0.2)) scan.emplace_back(p.x() - 0.2, p.y());
+  const NdtGrid plain(map, c);
+  const NdtGrid cut(map, c, {NdtView{Eigen::Vector2d::Zero(), 5.0}});
+  int truncated = 0, whole = 0;
+  for (const auto& layer : cut.layers()) {
+    for (int i = 0; i < layer.nx * layer.ny; ++i) {
+      const NdtCell& cell = layer.cells[static_cast<std::size_t>(i)];
+      if (!cell.valid) continue;
+      const double far_corner = layer.origin.x() + (i % layer.nx + 1) * c.cell_size;
+      if (cell.truncated) {
+        ++truncated;
+        EXPECT_GT(far_corner, 4.3);  // only cells reaching to the range's end
+      } else if (far_corner < 4.0) {
+        ++whole;
+        EXPECT_LT(cell.covariance(0, 0), 0.05);  // ≈ L²/12: a wall segment's own extent
+      }
+    }
+  }
+  EXPECT_GT(truncated, 0);
+  EXPECT_GT(whole, 20);
+  const Pose2D truth(0.2, 0.0, 0.0);
+  const double pull_plain = plain.score(truth, scan, true).gradient.x();
+  const double pull_cut = cut.score(truth, scan, true).gradient.x();
+  EXPECT_GT(pull_plain, 0.0);  // h grows forward: the plain score prefers the pose farther back
+  EXPECT_LT(std::abs(pull_cut), 0.1 * pull_plain);
+  RecordProperty("pull_plain_x1000", static_cast<int>(1000.0 * pull_plain));
+  RecordProperty("pull_cut_x1000", static_cast<int>(1000.0 * pull_cut));
 }

@@ -22,6 +22,14 @@ struct NdtGridConfig {
                                ///< cell; 0 = off (the plain Biber score)
 };
 
+/// Where the reference's points were seen from: the laser's position and its maximum range. A wall's
+/// returns end where the range ends, not where the wall does; a cell that reaches past every view's range
+/// holds only part of its wall (see NdtGrid::build).
+struct NdtView {
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  double range = 0.0;  ///< m
+};
+
 /// One Gaussian of the NDT. The inverse covariance is precomputed: it is what the score needs.
 struct NdtCell {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -30,6 +38,7 @@ struct NdtCell {
   double weight = 1.0;  ///< scale of this cell's exp() term (NdtGridConfig::point_sigma)
   int count = 0;
   bool valid = false;
+  bool truncated = false;  ///< a line cell cut by the views' range: no information along its line
 };
 
 /// Score of a moved point set. h is minimised (h = −Σ_i Σ_grids exp(−½ qᵀΣ⁻¹q)).
@@ -43,10 +52,17 @@ struct NdtScore {
 class NdtGrid {
  public:
   NdtGrid() = default;
-  NdtGrid(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config) { build(points, config); }
+  NdtGrid(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config,
+          const std::vector<NdtView>& views = {}) {
+    build(points, config, views);
+  }
 
-  /// Rebuilds the four grids over the bounding box of `points`.
-  void build(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config);
+  /// Rebuilds the four grids over the bounding box of `points`. With `views`, a line-like cell that no
+  /// view saw whole (a corner of the cell beyond every view's range) keeps its Gaussian across the line
+  /// only: its points end where the range did, so their mean is not the wall's, and a scan seen from
+  /// farther along would be pulled back towards it (along a corridor, a few mm per scan).
+  void build(const std::vector<Eigen::Vector2d>& points, const NdtGridConfig& config,
+             const std::vector<NdtView>& views = {});
 
   /// h at `pose` for `points` given in the moving frame; gradient and Hessian w.r.t. (x, y, θ) when
   /// `derivatives` is set (Jacobian at the scan-frame point, doc/algorithms.md §2).

@@ -92,8 +92,9 @@ class ScanMatcher {
  public:
   explicit ScanMatcher(const ScanMatcherConfig& config = ScanMatcherConfig());
 
-  /// Builds the NDT grids and the DE raster of the reference (points in the reference frame).
-  void setReference(const std::vector<Eigen::Vector2d>& points);
+  /// Builds the NDT grids and the DE raster of the reference (points in the reference frame; `views`:
+  /// where they were seen from, NdtGrid::build).
+  void setReference(const std::vector<Eigen::Vector2d>& points, const std::vector<NdtView>& views = {});
   bool hasReference() const;
 
   /// Matches `points` (in the scan's own frame) starting from `prior`.

@@ -151,12 +151,14 @@ class LaserOdometry {
     Pose2D pose;
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of `pose`, odom frame
     std::vector<Eigen::Vector2d> points;  ///< in the matching frame (the odom frame unless align_to_walls)
+    NdtView view;                         ///< where the laser saw them from, matching frame
   };
   struct WheelSample {
     double stamp;
     Pose2D pose;
   };
-  void addKeyframe(const std::vector<Eigen::Vector2d>& base_points);
+  void addKeyframe(const std::vector<Eigen::Vector2d>& base_points, const PreprocessedScan& scan,
+                   const LaserMount& mount);
   /// The wheels' motion from stamp `from` to `to` (in the robot's frame at `from`), interpolated between
   /// samples; false when the samples do not cover that interval.
   bool wheelMotion(double from, double to, Pose2D* motion) const;
@@ -169,7 +171,8 @@ class LaserOdometry {
   /// A scan with nothing to match: the pose moves by the motion prior, u says why.
   void propagateUnmatched(const PreprocessedScan& scan, OdometryUpdate& u);
   /// The first usable scan: the matching frame, the first keyframe.
-  void start(const PreprocessedScan& scan, const std::vector<Eigen::Vector2d>& base_points, OdometryUpdate& u);
+  void start(const PreprocessedScan& scan, const LaserMount& mount, const std::vector<Eigen::Vector2d>& base_points,
+             OdometryUpdate& u);
   /// The scan's match against the local map from `prior`, into u.match (and u.points_used).
   void matchToLocalMap(const PreprocessedScan& scan, const LaserMount& mount,
                        const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior, double dt,

@@ -15,12 +15,12 @@ ScanMatcher::ScanMatcher(const ScanMatcherConfig& config) : config_(config) {
   }
 }
 
-void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points) {
+void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points, const std::vector<NdtView>& views) {
   grids_.resize(config_.cell_sizes.size());
   for (std::size_t i = 0; i < grids_.size(); ++i) {
     NdtGridConfig c = config_.ndt;
     c.cell_size = config_.cell_sizes[i];
-    grids_[i].build(points, c);
+    grids_[i].build(points, c, views);
   }
   if (config_.use_de) raster_.build(grids_.front(), config_.raster_resolution);
 }

@@ -35,8 +35,11 @@ void LaserOdometry::reset() {
   held_since_ = kNoConstrainedMatch;
 }
 
-void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points) {
+void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points, const PreprocessedScan& scan,
+                                const LaserMount& mount) {
   Keyframe kf;
+  kf.view.origin = pose_.transform(mount.t);
+  kf.view.range = scan.range_max;
   kf.pose = pose_;
   kf.covariance = pose_covariance_;
   kf.points.reserve(base_points.size());
@@ -46,8 +49,12 @@ void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points)
   keyframe_matched_ = -1.0;
   while (static_cast<int>(keyframes_.size()) > std::max(1, config_.local_map_keyframes)) keyframes_.pop_front();
   std::vector<Eigen::Vector2d> map;
-  for (const auto& k : keyframes_) map.insert(map.end(), k.points.begin(), k.points.end());
-  matcher_.setReference(voxelFilter(map, config_.map_voxel));
+  std::vector<NdtView> views;  // where the keyframes were taken: the cells their range cut (NdtGrid::build)
+  for (const auto& k : keyframes_) {
+    map.insert(map.end(), k.points.begin(), k.points.end());
+    if (k.view.range > 0.0) views.push_back(k.view);
+  }
+  matcher_.setReference(voxelFilter(map, config_.map_voxel), views);
 }
 
 namespace {
@@ -172,7 +179,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     return u;
   }
   if (!initialized_) {
-    start(scan, base_points, u);
+    start(scan, mount, base_points, u);
     return u;
   }
 
@@ -207,7 +214,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   last_stamp_ = scan.stamp;
 
   if (keyframeDue(u.match)) {
-    addKeyframe(base_points);
+    addKeyframe(base_points, scan, mount);
     u.new_keyframe = true;
   }
   previous_scan_ = scan;
@@ -237,7 +244,8 @@ void LaserOdometry::propagateUnmatched(const PreprocessedScan& scan, OdometryUpd
   u.velocity = velocity_;
 }
 
-void LaserOdometry::start(const PreprocessedScan& scan, const std::vector<Eigen::Vector2d>& base_points,
+void LaserOdometry::start(const PreprocessedScan& scan, const LaserMount& mount,
+                          const std::vector<Eigen::Vector2d>& base_points,
                           OdometryUpdate& u) {
   initialized_ = true;
   last_stamp_ = scan.stamp;
@@ -250,7 +258,7 @@ void LaserOdometry::start(const PreprocessedScan& scan, const std::vector<Eigen:
   pose_ = Pose2D(0.0, 0.0, frame_angle_);
   pose_covariance_.setZero();
   velocity_.setZero();
-  addKeyframe(base_points);
+  addKeyframe(base_points, scan, mount);
   previous_scan_ = scan;
   last_flow_ = RangeFlow();  // a flow from before a reset says nothing about this start
   u.ok = true;
