@@ -63,26 +63,12 @@ namespace {
 constexpr double kWheelExtrapolation = 0.25;
 // Bound on the samples kept while no scan arrives (a laser that stopped): ~2 min at 66 Hz.
 constexpr std::size_t kMaxWheelSamples = 8192;
-// σ of the wheels' motion between two scans: kWheelScaleSigma of the distance (encoder scale error, slip on
-// carpet or at a bump: a few per cent) plus kWheelMinSigma (quantisation, vibration at rest).
-constexpr double kWheelScaleSigma = 0.05;
-constexpr double kWheelMinSigma = 0.001;  // m
 
 // σ of a held velocity along a corridor (m/s): kHeldSpeedSigma of the speed plus kHeldMinSpeedSigma. It was
 // smoothed over the constrained matches before the hold; 1-3 % off on the simulated corridors
 // (doc/experiments.md).
 constexpr double kHeldSpeedSigma = 0.02;
 constexpr double kHeldMinSpeedSigma = 0.005;  // m/s
-
-// The covariance of a motion whose component along the unit vector `weak` (translation) has variance `v`
-// (the wheels') instead of the match's: the match's component along it is projected out.
-Eigen::Matrix3d withVarianceAlong(const Eigen::Matrix3d& c, const Eigen::Vector2d& weak, double v) {
-  Eigen::Matrix3d p = Eigen::Matrix3d::Identity();
-  p.topLeftCorner<2, 2>() -= weak * weak.transpose();
-  Eigen::Matrix3d out = p * c * p.transpose();
-  out.topLeftCorner<2, 2>() += v * weak * weak.transpose();
-  return out;
-}
 
 // The scan without its points beyond (range_max − margin), into *out; false (out untouched) when nothing
 // would be left out or fewer than min_points would remain (open space: match everything).
@@ -300,12 +286,9 @@ void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) 
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   R.topLeftCorner<2, 2>() = previous.rotation();
   u.delta_covariance = R.transpose() * u.match.covariance * R;
-  if (u.wheel_prior && u.match.degenerate) {
-    // The match kept the wheels' motion along its weak direction: that component's error is theirs.
-    const double sigma = kWheelScaleSigma * std::hypot(u.delta.x, u.delta.y) + kWheelMinSigma;
-    u.delta_covariance = withVarianceAlong(u.delta_covariance, previous.rotation().transpose() * u.match.weak_direction,
-                                         sigma * sigma);
-  }
+  // Where the match hardly constrains the motion (a corridor's length, a ridge of the score in heading) it
+  // kept the wheels' motion, so that component's error is theirs; where it constrains, it is the match's.
+  if (u.wheel_prior) u.delta_covariance = boundedByWheels(u.delta_covariance, wheelMotionSigma(u.delta));
   // The delta's covariance is the matcher's as it is (the SLAM's proposal follows its direction even where
   // it is huge); the pose covariance takes the bounded one. The scan was matched against the local map, not
   // the previous scan, so its error does not add up scan by scan: the pose is the newest keyframe's (whose
