@@ -6,6 +6,7 @@
 #include <functional>
 #include <limits>
 
+#include "laser_dpslam/odometry/wheel_motion.h"
 #include "laser_dpslam/sim/scan_simulator.h"
 #include "laser_dpslam/sim/sim_path.h"
 #include "test_rooms.h"

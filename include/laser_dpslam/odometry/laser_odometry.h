@@ -14,7 +14,6 @@
 #include "laser_dpslam/common/pose2d.h"
 #include "laser_dpslam/matching/scan_matcher.h"
 #include "laser_dpslam/odometry/range_flow.h"
-#include "laser_dpslam/odometry/wheel_motion.h"
 #include "laser_dpslam/scan/saliency_resampler.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
 #include "laser_dpslam/scan/scan_resampler.h"

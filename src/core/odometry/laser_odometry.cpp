@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "laser_dpslam/odometry/wheel_motion.h"
 #include "laser_dpslam/scan/voxel_filter.h"
 #include "laser_dpslam/scan/wall_direction.h"
 
@@ -289,8 +290,8 @@ void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) 
   // Where the match hardly constrains the motion (a corridor's length, a ridge of the score in heading) it
   // kept the wheels' motion, so that component's error is theirs; where it constrains, it is the match's.
   if (u.wheel_prior) u.delta_covariance = boundedByWheels(u.delta_covariance, wheelMotionSigma(u.delta));
-  // The delta's covariance is the matcher's as it is (the SLAM's proposal follows its direction even where
-  // it is huge); the pose covariance takes the bounded one. The scan was matched against the local map, not
+  // Without wheels the delta's covariance is the matcher's as it is (the SLAM's proposal follows its
+  // direction even where it is huge); the pose covariance takes the bounded one. The scan was matched against the local map, not
   // the previous scan, so its error does not add up scan by scan: the pose is the newest keyframe's (whose
   // covariance was fixed when it was taken) composed with this match, Σ = Ja·Σ_kf·Jaᵀ + Σ_match (odom
   // frame). Summing every scan's match instead overstated σ about fivefold (demo: 0.51 m after 24 m, real
