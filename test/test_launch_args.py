@@ -114,9 +114,12 @@ class LaunchArgsTest(unittest.TestCase):
         self.assertEqual(p["/urg_node/serial_port"].value, "/dev/ttyACM0")
         self.assertEqual(len(n["laser_mount_tf"].args.split()), 8)  # x y z yaw pitch roll parent child
 
-    def test_wheel_odometry_reaches_the_laser_odometry(self):
+    def test_wheel_odometry_reaches_both_nodes(self):
         def use(*args):
-            return load("robot.launch", *args).params["/laser_odometry_node/use_wheel_odometry"].value
+            p = load("robot.launch", *args).params
+            odometry, slam = p["/laser_odometry_node/use_wheel_odometry"].value, p["/dpslam_node/use_wheel_odometry"].value
+            self.assertEqual(odometry, slam)  # the SLAM bounds its noise by the wheels only when they are fused
+            return odometry
         self.assertFalse(use())  # the YAML's default: laser only
         self.assertTrue(use("wheel_odometry:=true"))
         self.assertFalse(use("wheel_odometry:=true", "create:=false"))  # no base driver, no wheels

@@ -58,7 +58,8 @@ const char* kUsage =
     "                      [--wheel-odom TOPIC]     (the wheels' nav_msgs/Odometry in the bag, e.g. /wheel_odom:\n"
     "                                               their motion between two scans replaces the odometry's\n"
     "                                               constant-velocity prediction, as laser_odometry_node does\n"
-    "                                               with use_wheel_odometry)\n"
+    "                                               with use_wheel_odometry, and the SLAM's particles spread\n"
+    "                                               no more than the wheels' error, as dpslam_node does)\n"
     "Outputs are written at the end, stats.json last; a failed run (e.g. a corrupted bag) writes none.\n"
     "When scan time goes backwards (a looped bag) the odometry and the SLAM start over, as the nodes\n"
     "do, and the outputs describe the part after the last such reset.\n";
@@ -631,6 +632,7 @@ int main(int argc, char** argv) {
   Configs configs;
   std::vector<StampedPose> motion;
   if (!readConfigs(args, &configs) || !readMotion(args, &motion)) return 2;
+  if (!args.wheel_odom.empty()) configs.slam.proposal.bounded_by_wheels = true;  // as use_wheel_odometry
   rosbag::Bag bag;
   std::FILE* memory_log = nullptr;
   if (!openFiles(args, bag, &memory_log)) return 1;

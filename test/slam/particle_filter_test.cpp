@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 #include <random>
+
+#include "laser_dpslam/odometry/wheel_motion.h"
 
 using namespace laser_dpslam;
 
@@ -160,6 +163,36 @@ TEST(Proposal, NoiseFloorAddsUpOverTheScansComposed) {
   EXPECT_NEAR(s4(1, 1) - s1(1, 1), 3 * 1e-4, 1e-12);
   EXPECT_NEAR(s4(2, 2) - s1(2, 2), 3 * 2.5e-5, 1e-12);
   EXPECT_NEAR(s1(0, 0), 4e-4 + 1e-4 + 9e-4, 1e-12);
+}
+
+// With wheel odometry fused, no direction of the proposal spreads beyond the wheels' error: at rest the 1 cm
+// floor shrinks to the wheels' millimetre; moving, the heading floor below the wheels' own heading error stays.
+TEST(Proposal, WheelsBoundTheWholeNoiseFloorsIncluded) {
+  ProposalNoise noise;
+  noise.min_sigma_xy = 0.01;
+  noise.min_sigma_theta = 0.005;
+  noise.bounded_by_wheels = true;
+  const Eigen::Matrix3d tiny = Eigen::Matrix3d::Identity() * 1e-8;
+  const auto covariance = [&](const Pose2D& delta, int scans) {
+    const Eigen::Matrix3d L = proposalFactor(delta, tiny, noise, scans);
+    return Eigen::Matrix3d(L * L.transpose());
+  };
+  const auto withinWheels = [](const Eigen::Matrix3d& s, const Eigen::Vector3d& w) {
+    const Eigen::Matrix3d scaled = w.cwiseInverse().asDiagonal() * s * w.cwiseInverse().asDiagonal();
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scaled).eigenvalues().maxCoeff() <= 1.0 + 1e-9;
+  };
+  const Eigen::Matrix3d rest = covariance(Pose2D(), 1);
+  EXPECT_TRUE(withinWheels(rest, wheelMotionSigma(Pose2D())));
+  EXPECT_NEAR(std::sqrt(rest(0, 0)), wheelMotionSigma(Pose2D())(0), 1e-9);  // the floor's 1 cm cut to 1 mm
+  const Pose2D step(0.03, 0.0, 0.0);  // 0.3 m/s at 10 Hz
+  const Eigen::Matrix3d moving = covariance(step, 1);
+  EXPECT_TRUE(withinWheels(moving, wheelMotionSigma(step)));
+  EXPECT_NEAR(std::sqrt(moving(0, 0)), wheelMotionSigma(step)(0), 1e-9);
+  EXPECT_NEAR(moving(2, 2), 2.5e-5 + 1e-8, 1e-12);  // 0.005 rad is inside the wheels' 0.0068 rad: kept
+  // Composed over 4 scans the wheels' floors add up in variance, as the proposal's do.
+  EXPECT_NEAR(std::sqrt(covariance(Pose2D(), 4)(0, 0)), 2.0 * wheelMotionSigma(Pose2D())(0), 1e-9);
+  noise.bounded_by_wheels = false;
+  EXPECT_NEAR(covariance(Pose2D(), 1)(0, 0), 1e-4 + 1e-8, 1e-12);
 }
 
 TEST(WeightedPoseCovariance, WrapsAnglesAroundPi) {

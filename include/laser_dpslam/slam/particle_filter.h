@@ -33,7 +33,8 @@ class GaussianSampler {
 /// The proposal's noise: Σ = F·(scale·Σ_Δ)·F + diag(min_xy², min_xy², min_θ²) + diag((k_xy·|t|)², (k_xy·|t|)², (k_θ·|Δθ|)²),
 /// with |t| the translation and |Δθ| the rotation of the delta, and F a diagonal scaling that brings the
 /// standard deviations of scale·Σ_Δ down to at most max_sigma_xy / max_sigma_theta (correlations kept), so
-/// that a wild covariance from a failed match cannot scatter the particles. Returns the lower Cholesky
+/// that a wild covariance from a failed match cannot scatter the particles. With bounded_by_wheels the whole Σ,
+/// floors included, is then cut to the wheels' error along every direction (boundedByWheels). Returns the lower Cholesky
 /// factor L (Σ = L·Lᵀ); an invalid Σ_Δ (not finite or not positive semi-definite) is replaced by its
 /// diagonal's absolute values.
 struct ProposalNoise {
@@ -44,6 +45,10 @@ struct ProposalNoise {
   double sigma_theta_per_rad = 0.0;  ///< rad of standard deviation per rad turned
   double max_sigma_xy = 0.1;      ///< m, cap of the scan matcher's translation standard deviation
   double max_sigma_theta = 0.1;   ///< rad, cap of the scan matcher's rotation standard deviation
+  /// The odometry fuses wheel odometry: the particles never spread beyond the wheels' error (wheel_motion.h).
+  /// The floors hedge against an optimistic scan match; where the wheels know the motion better than the floor
+  /// (along a corridor, at rest) the floor's spread is only a random walk the map cannot take back.
+  bool bounded_by_wheels = false;
 };
 Eigen::Matrix3d proposalFactor(const Pose2D& delta, const Eigen::Matrix3d& delta_cov, const ProposalNoise& noise,
                                int scans = 1);

@@ -1,6 +1,7 @@
 #include "laser_dpslam/odometry/wheel_motion.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 namespace laser_dpslam {
@@ -16,11 +17,12 @@ constexpr double kWheelBase = 0.258;             // m
 constexpr double kWheelMinSigmaTheta = 0.001;    // rad
 }  // namespace
 
-Eigen::Vector3d wheelMotionSigma(const Pose2D& motion) {
+Eigen::Vector3d wheelMotionSigma(const Pose2D& motion, int scans) {
   const double d = std::hypot(motion.x, motion.y);
-  const double sigma_xy = kWheelScaleSigma * d + kWheelMinSigma;
+  const double floors = std::sqrt(static_cast<double>(std::max(1, scans)));
+  const double sigma_xy = kWheelScaleSigma * d + floors * kWheelMinSigma;
   return Eigen::Vector3d(sigma_xy, sigma_xy,
-                         kWheelScaleSigma * (std::abs(motion.theta) + d / kWheelBase) + kWheelMinSigmaTheta);
+                         kWheelScaleSigma * (std::abs(motion.theta) + d / kWheelBase) + floors * kWheelMinSigmaTheta);
 }
 
 Eigen::Matrix3d boundedByWheels(const Eigen::Matrix3d& c, const Eigen::Vector3d& wheel_sigma) {

@@ -71,6 +71,10 @@ std::vector<Parameter<S>> filterEntries() {
        "cap of the scan matcher's translation standard deviation (failed matches)", kAdvanced},
       {"proposal_max_sigma_theta", "particle filter", FIELD(slam.proposal.max_sigma_theta), "rad", above(0),
        "cap of the scan matcher's rotation standard deviation", kAdvanced},
+      {"use_wheel_odometry", "particle filter", FIELD(slam.proposal.bounded_by_wheels), "bool", anyValue(),
+       "the laser odometry fuses the wheels (its own use_wheel_odometry): the particles then never spread beyond "
+       "the wheels' error, floors included (dpslam_offline --wheel-odom TOPIC sets it)",
+       kUser},
       {"explore_noise_scale", "particle filter", FIELD(slam.explore_noise_scale), "-", leftOpenInterval(0, 1),
        "proposal noise multiplier while exploring (no old path of the filter within revisit_radius); 1 = off",
        kAdvanced},

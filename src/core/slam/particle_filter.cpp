@@ -1,5 +1,7 @@
 #include "laser_dpslam/slam/particle_filter.h"
 
+#include "laser_dpslam/odometry/wheel_motion.h"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -49,6 +51,7 @@ Eigen::Matrix3d proposalFactor(const Pose2D& delta, const Eigen::Matrix3d& delta
   sigma(0, 0) += sxy;
   sigma(1, 1) += sxy;
   sigma(2, 2) += scans * n.min_sigma_theta * n.min_sigma_theta + std::pow(n.sigma_theta_per_rad * r, 2);
+  if (n.bounded_by_wheels) sigma = boundedByWheels(sigma, wheelMotionSigma(delta, scans));
   Eigen::LLT<Eigen::Matrix3d> llt(sigma);
   if (llt.info() == Eigen::Success) return llt.matrixL();
   Eigen::Matrix3d diag = Eigen::Matrix3d::Zero();
