@@ -10,7 +10,7 @@ namespace laser_dpslam {
 /// σ (x, y, θ) of the wheel odometry's motion `motion` between two scans: a few per cent of the distance and
 /// of the turn (encoder scale, slip), the two wheels' scale errors apart turning the heading over the distance
 /// (differential drive), plus floors for quantisation and vibration at rest. Over a motion composed from
-/// `scans` scans' the floors add up in variance.
+/// `scans` scans, the floors add up in variance.
 Eigen::Vector3d wheelMotionSigma(const Pose2D& motion, int scans = 1);
 
 /// The covariance `c` of a matched motion, never above the wheels' (σ `wheel_sigma`, independent axes) along
