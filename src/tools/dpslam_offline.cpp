@@ -188,6 +188,7 @@ bool readConfigs(const Args& args, Configs* c) {
       c->odom.seed = static_cast<std::uint64_t>(args.seed);
       c->slam.seed = static_cast<std::uint64_t>(args.seed);
     }
+    if (!args.wheel_odom.empty()) c->slam.proposal.bounded_by_wheels = true;  // as use_wheel_odometry
     c->slam.validate();
   } catch (const std::exception& e) {
     std::cerr << "dpslam_offline: " << e.what() << "\n";
@@ -632,7 +633,6 @@ int main(int argc, char** argv) {
   Configs configs;
   std::vector<StampedPose> motion;
   if (!readConfigs(args, &configs) || !readMotion(args, &motion)) return 2;
-  if (!args.wheel_odom.empty()) configs.slam.proposal.bounded_by_wheels = true;  // as use_wheel_odometry
   rosbag::Bag bag;
   std::FILE* memory_log = nullptr;
   if (!openFiles(args, bag, &memory_log)) return 1;

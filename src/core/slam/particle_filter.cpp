@@ -1,12 +1,12 @@
 #include "laser_dpslam/slam/particle_filter.h"
 
-#include "laser_dpslam/odometry/wheel_motion.h"
-
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "laser_dpslam/odometry/wheel_motion.h"
 
 namespace laser_dpslam {
 
