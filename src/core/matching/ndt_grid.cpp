@@ -138,32 +138,48 @@ NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& 
     const double jx = -s * a.x() - c * a.y(), jy = c * a.x() - s * a.y();
     const double hx = -c * a.x() + s * a.y(), hy = -s * a.x() - c * a.y();
     const Eigen::Vector2d x(xx, xy);
-    bool matched = false;
+    // The point's terms are computed for all four layers first and summed after, in layer order as
+    // before: the four exp() are then independent of the sums, and the CPU overlaps them.
+    const NdtCell* cells[4];
+    int n = 0;
     for (const Layer& layer : layers_) {
-      const NdtCell* cell = layer.cellAt(x, inv);
-      if (!cell) continue;
+      if (const NdtCell* cell = layer.cellAt(x, inv)) cells[n++] = cell;
+    }
+    double e[4], iq[4][2];
+    bool near[4];
+    bool matched = false;
+    for (int k = 0; k < n; ++k) {
+      const NdtCell* cell = cells[k];
       const double qx = xx - cell->mean.x(), qy = xy - cell->mean.y();
       const double a00 = cell->information(0, 0), a01 = cell->information(0, 1), a11 = cell->information(1, 1);
-      const double iqx = a00 * qx + a01 * qy, iqy = a01 * qx + a11 * qy;  // Σ⁻¹q
-      const double m2 = qx * iqx + qy * iqy;
+      iq[k][0] = a00 * qx + a01 * qy;  // Σ⁻¹q
+      iq[k][1] = a01 * qx + a11 * qy;
+      const double m2 = qx * iq[k][0] + qy * iq[k][1];
       if (m2 < 9.0) matched = true;
-      if (m2 > 40.0) continue;  // exp(−20) ≈ 2e-9: no contribution worth an exp()
-      const double e = cell->weight * negExp(0.5 * m2);
-      h -= e;
+      // exp(−20) ≈ 2e-9: no contribution worth an exp()
+      near[k] = m2 <= 40.0;
+      e[k] = near[k] ? cell->weight * negExp(0.5 * m2) : 0.0;
+    }
+    for (int k = 0; k < n; ++k) {
+      if (!near[k]) continue;
+      const NdtCell* cell = cells[k];
+      const double a00 = cell->information(0, 0), a01 = cell->information(0, 1), a11 = cell->information(1, 1);
+      const double iqx = iq[k][0], iqy = iq[k][1];
+      h -= e[k];
       if (!derivatives) continue;
       // g_k = e·qᵀΣ⁻¹J_k with J = [e_x, e_y, j_θ].
       const double qj = iqx * jx + iqy * jy;
-      g0 += e * iqx;
-      g1 += e * iqy;
-      g2 += e * qj;
+      g0 += e[k] * iqx;
+      g1 += e[k] * iqy;
+      g2 += e[k] * qj;
       // H_kl = e·[−(qᵀΣ⁻¹J_k)(qᵀΣ⁻¹J_l) + qᵀΣ⁻¹∂²x'/∂p_k∂p_l + J_lᵀΣ⁻¹J_k]
       const double ijx = a00 * jx + a01 * jy, ijy = a01 * jx + a11 * jy;  // Σ⁻¹j_θ
-      H00 += e * (a00 - iqx * iqx);
-      H01 += e * (a01 - iqx * iqy);
-      H02 += e * (ijx - iqx * qj);
-      H11 += e * (a11 - iqy * iqy);
-      H12 += e * (ijy - iqy * qj);
-      H22 += e * (jx * ijx + jy * ijy - qj * qj + iqx * hx + iqy * hy);
+      H00 += e[k] * (a00 - iqx * iqx);
+      H01 += e[k] * (a01 - iqx * iqy);
+      H02 += e[k] * (ijx - iqx * qj);
+      H11 += e[k] * (a11 - iqy * iqy);
+      H12 += e[k] * (ijy - iqy * qj);
+      H22 += e[k] * (jx * ijx + jy * ijy - qj * qj + iqx * hx + iqy * hy);
     }
     if (matched) ++out.matched;
   }
