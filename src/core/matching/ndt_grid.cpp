@@ -138,8 +138,9 @@ NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& 
     const double jx = -s * a.x() - c * a.y(), jy = c * a.x() - s * a.y();
     const double hx = -c * a.x() + s * a.y(), hy = -s * a.x() - c * a.y();
     const Eigen::Vector2d x(xx, xy);
-    // The point's terms are computed for all four layers first and summed after, in layer order as
-    // before: the four exp() are then independent of the sums, and the CPU overlaps them.
+    // The point's terms are computed for all four layers first and summed after, in layer order: the four
+    // exp() are then independent of the sums, and the CPU overlaps them. (Skipping a far cell inside this
+    // first loop, rather than flagging it, put the branch back before the exp() and lost the gain.)
     const NdtCell* cells[4];
     int n = 0;
     for (const Layer& layer : layers_) {
