@@ -116,6 +116,7 @@ struct OdometryUpdate {
   /// The velocity along match.weak_direction was held (degenerate_hold_time): the pose's variance along it
   /// grows with the time held.
   bool velocity_held = false;
+  bool velocity_held_blank = false;  ///< no surface in the scan faces along the corridor: the match kept the prior along it
   bool wheel_prior = false;           ///< the motion prior was the wheel odometry's (addWheelOdometry)
   bool new_keyframe = false;
   int points_used = 0;
@@ -174,6 +175,14 @@ class LaserOdometry {
   void start(const PreprocessedScan& scan, const LaserMount& mount, const std::vector<Eigen::Vector2d>& base_points,
              OdometryUpdate& u);
   /// The scan's match against the local map from `prior`, into u.match (and u.points_used).
+  /// Whether the scan, at the prior's heading, shows no surface facing along the last match's weak direction
+  /// (a blank stretch of corridor): then the match keeps the prior along it.
+  bool blankAlongCorridor(const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior) const;
+  /// Cuts a degenerate match's step along its weak direction to kDegenerateStepSigmas · prior_sigma from the prior.
+  static void limitDegenerateStep(const Pose2D& prior, double prior_sigma, MatchResult& m);
+  /// Keeps the poses of matches outside blank stretches; at a blank stretch's first scan, the held speed.
+  void seeAlongCorridor(double stamp, const OdometryUpdate& u);
+  void holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d& weak);
   void matchToLocalMap(const PreprocessedScan& scan, const LaserMount& mount,
                        const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior, double dt,
                        OdometryUpdate& u);
@@ -204,6 +213,18 @@ class LaserOdometry {
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  ///< base frame, per second
   std::deque<Keyframe> keyframes_;
+  // Blank stretches of corridor (doc/algorithms.md §5, doc/experiments.md "Blank stretches told by the
+  // surfaces facing along them"). Less than this much surface facing along the corridor (m) is a blank
+  // stretch: about one door jamb's face; on the generated buildings' blank corridors the scans show none.
+  static constexpr double kMinFacingLength = 0.1;
+  // A degenerate match moves the pose along its weak direction by at most this many prior σ from the prior.
+  static constexpr double kDegenerateStepSigmas = 3.0;
+  // s of matches outside blank stretches the held speed is fitted to, and the shortest window tried.
+  static constexpr double kHoldSpeedWindow = 3.0;
+  static constexpr double kMinHoldSpeedWindow = 0.5;
+  // The window's two halves agree within this fraction of the speed plus kHoldSpeedAgreementMin (m/s).
+  static constexpr double kHoldSpeedAgreement = 0.03;
+  static constexpr double kHoldSpeedAgreementMin = 0.005;
   static constexpr double kNoConstrainedMatch = -1e300;  ///< constrained_stamp_ when there is nothing to hold
   double constrained_stamp_ = kNoConstrainedMatch;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
   double held_since_ = kNoConstrainedMatch;  ///< stamp of the first scan of the current hold (none: not holding)
@@ -211,6 +232,9 @@ class LaserOdometry {
   PreprocessedScan previous_scan_;  ///< the last scan matched (range_flow_gain)
   RangeFlow last_flow_;              ///< the range flow measured with the last scan (invalid: none)
   Eigen::Vector2d last_flow_direction_ = Eigen::Vector2d::Zero();  ///< its direction (the match's weak direction, matching frame)
+  Eigen::Vector2d last_weak_ = Eigen::Vector2d::Zero();  ///< the last match's weak direction if it was degenerate (matching frame), else 0
+  std::deque<std::pair<double, Pose2D>> seen_along_;  ///< poses of the last kHoldSpeedWindow s of matches outside blank stretches
+  bool was_blank_ = false;  ///< the last scan was in a blank stretch (velocity_held_blank)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;
   std::deque<WheelSample> wheels_;  ///< wheel odometry since shortly before the last scan (addWheelOdometry)

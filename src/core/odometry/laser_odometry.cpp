@@ -1,8 +1,12 @@
 #include "laser_dpslam/odometry/laser_odometry.h"
 
 #include <cmath>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
 
 #include "laser_dpslam/odometry/wheel_motion.h"
+#include "laser_dpslam/scan/facing_surfaces.h"
 #include "laser_dpslam/scan/voxel_filter.h"
 #include "laser_dpslam/scan/wall_direction.h"
 
@@ -34,6 +38,9 @@ void LaserOdometry::reset() {
   scan_count_ = 0;
   constrained_stamp_ = kNoConstrainedMatch;
   held_since_ = kNoConstrainedMatch;
+  last_weak_.setZero();
+  seen_along_.clear();
+  was_blank_ = false;
 }
 
 void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points, const PreprocessedScan& scan,
@@ -92,6 +99,42 @@ bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_point
     out->angles.push_back(scan.angles[i]);
   }
   return true;
+}
+
+// The points of `seen` (stamped poses, oldest first) from the first at or after `from` to the last at or
+// before `to`, when they span at least 40 % of the interval.
+using StampedPoses = std::deque<std::pair<double, Pose2D>>;
+bool spanOf(const StampedPoses& seen, double from, double to, const Pose2D** a, const Pose2D** b, double* dt) {
+  const std::pair<double, Pose2D>* first = nullptr;
+  const std::pair<double, Pose2D>* last = nullptr;
+  for (const auto& e : seen) {
+    if (e.first >= from && !first) first = &e;
+    if (e.first <= to) last = &e;
+  }
+  if (!first || !last || last->first - first->first < 0.4 * (to - from)) return false;
+  *a = &first->second;
+  *b = &last->second;
+  *dt = last->first - first->first;
+  return true;
+}
+
+// Least-squares slope (m/s) of the positions of `seen` since `from` along w (base frame of `frame`).
+double speedFit(const StampedPoses& seen, double from, double end, const Eigen::Matrix2d& frame,
+                const Eigen::Vector2d& w, double fallback) {
+  double st = 0, sp = 0, stt = 0, stp = 0;
+  int m = 0;
+  for (const auto& e : seen) {
+    if (e.first < from) continue;
+    const double t = e.first - end;
+    const double q = w.dot(frame.transpose() * Eigen::Vector2d(e.second.x, e.second.y));
+    st += t;
+    sp += q;
+    stt += t * t;
+    stp += t * q;
+    ++m;
+  }
+  const double den = m * stt - st * st;
+  return den > 0.0 ? (m * stp - st * sp) / den : fallback;
 }
 
 }  // namespace
@@ -190,6 +233,7 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   matchCovariances(previous, u);
   if (dt > 0.0 && dt <= config_.max_prior_gap) {
     updateVelocity(scan, mount, previous, dt, u);
+    seeAlongCorridor(scan.stamp, u);
     heldCovariance(previous, scan.stamp, dt, u);
   } else {
     held_since_ = kNoConstrainedMatch;
@@ -277,9 +321,18 @@ void LaserOdometry::matchToLocalMap(const PreprocessedScan& scan, const LaserMou
                                  ? 0.5 * config_.prior_acceleration * dt * dt
                                  : -1.0;
   // The wheels measure the motion: no release from their prior, and along a corridor the match keeps it.
-  const bool may_release = !u.wheel_prior && config_.prior_release_speed > 0.0 &&
+  // In a blank stretch of corridor nothing measures the motion along it either.
+  // Only for short-range lasers, as the corridor hold (degenerate_velocity_max_range): a long-range one sees
+  // a corridor's ends, and its returns at range lie farther apart than facingLength fits a surface over.
+  const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
+                           scan.range_max <= config_.degenerate_velocity_max_range;
+  u.velocity_held_blank = short_range && !u.wheel_prior && blankAlongCorridor(base_points, prior);
+  const bool hold = u.wheel_prior || u.velocity_held_blank;
+  const bool may_release = !hold && config_.prior_release_speed > 0.0 &&
                            velocity_.head<2>().norm() < config_.prior_release_speed;
-  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release, u.wheel_prior);
+  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release, hold);
+  if (short_range && !u.wheel_prior) limitDegenerateStep(prior, prior_sigma, u.match);
+  last_weak_ = u.match.valid && u.match.degenerate ? u.match.weak_direction : Eigen::Vector2d::Zero();
 }
 
 void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) {
@@ -374,6 +427,62 @@ void LaserOdometry::velocityAlongCorridor(const PreprocessedScan& scan, const La
     velocity_.head<2>() += weak * (before_w + config_.range_flow_gain * (mean - before_w) - weak.dot(velocity_.head<2>()));
   } else if (gw >= 0.0 || hold) {
     velocity_.head<2>() += weak * (((hold ? 0.0 : gw) - g) * weak.dot(measured.head<2>() - before));
+  }
+}
+
+bool LaserOdometry::blankAlongCorridor(const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior) const {
+  if (last_weak_.squaredNorm() == 0.0) return false;  // the last match constrained every direction
+  const Eigen::Vector2d w = Pose2D(0.0, 0.0, prior.theta).rotation().transpose() * last_weak_;
+  return facingLength(base_points, w) <= kMinFacingLength;
+}
+
+void LaserOdometry::limitDegenerateStep(const Pose2D& prior, double prior_sigma, MatchResult& m) {
+  if (!m.valid || !m.degenerate || m.prior_released || !(prior_sigma > 0.0)) return;
+  // Along a degenerate direction the scan cannot place the robot farther from the constant-velocity prior
+  // than an acceleration within prior_acceleration explains: a longer step is a false optimum of a flat
+  // score (a corridor's), and one such step taken into the velocity sends the estimate backwards. A released
+  // prior is the exception: the scan fitted clearly better away from it (a start from rest).
+  const Eigen::Vector2d w = m.weak_direction;
+  const double d = w.dot(Eigen::Vector2d(m.pose.x - prior.x, m.pose.y - prior.y));
+  const double limit = kDegenerateStepSigmas * prior_sigma;
+  if (std::abs(d) > limit) {
+    const double cut = d - std::copysign(limit, d);
+    m.pose.x -= cut * w.x();
+    m.pose.y -= cut * w.y();
+  }
+}
+
+void LaserOdometry::seeAlongCorridor(double stamp, const OdometryUpdate& u) {
+  if (u.velocity_held_blank && !was_blank_) holdSpeedFromSeenMatches(stamp, u.match.weak_direction);
+  if (!u.velocity_held_blank) seen_along_.push_back({stamp, pose_});
+  while (!seen_along_.empty() && seen_along_.front().first < stamp - kHoldSpeedWindow) seen_along_.pop_front();
+  was_blank_ = u.velocity_held_blank;
+}
+
+void LaserOdometry::holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d& weak) {
+  // A blank stretch starts: the speed it keeps along the corridor is fitted to the last seconds of matches
+  // that saw something along it, rather than the last few scans' smoothed velocity (a few per cent off,
+  // which a 40 m corridor turns into metres). The window halves until its two halves agree (no acceleration
+  // inside it); with no such window the smoothed velocity stays.
+  while (!seen_along_.empty() && seen_along_.front().first < stamp - kHoldSpeedWindow) seen_along_.pop_front();
+  const Eigen::Matrix2d frame = pose_.rotation();
+  const Eigen::Vector2d w = frame.transpose() * weak;  // base frame
+  const double end = seen_along_.empty() ? stamp : seen_along_.back().first;
+  auto speed = [&](double from, double to) {
+    const Pose2D* a;
+    const Pose2D* b;
+    double dt;
+    if (!spanOf(seen_along_, from, to, &a, &b, &dt)) return std::numeric_limits<double>::quiet_NaN();
+    return w.dot(frame.transpose() * Eigen::Vector2d(b->x - a->x, b->y - a->y)) / dt;
+  };
+  for (double span = kHoldSpeedWindow; span >= kMinHoldSpeedWindow; span *= 0.5) {
+    const double all = speed(end - span, end), first = speed(end - span, end - 0.5 * span),
+                 second = speed(end - 0.5 * span, end);
+    if (!std::isfinite(all) || !std::isfinite(first) || !std::isfinite(second)) continue;
+    if (std::abs(first - second) > kHoldSpeedAgreement * std::abs(all) + kHoldSpeedAgreementMin) continue;
+    const double v = speedFit(seen_along_, end - span, end, frame, w, all);
+    velocity_.head<2>() += w * (v - w.dot(velocity_.head<2>()));
+    return;
   }
 }
 
