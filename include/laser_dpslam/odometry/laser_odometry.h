@@ -174,7 +174,9 @@ class LaserOdometry {
   /// The first usable scan: the matching frame, the first keyframe.
   void start(const PreprocessedScan& scan, const LaserMount& mount, const std::vector<Eigen::Vector2d>& base_points,
              OdometryUpdate& u);
-  /// The scan's match against the local map from `prior`, into u.match (and u.points_used).
+  /// The corridor handling (hold, degenerate gain, blank stretches) is for lasers up to
+  /// degenerate_velocity_max_range.
+  bool shortRange(const PreprocessedScan& scan) const;
   /// Whether the scan, at the prior's heading, shows no surface facing along the last match's weak direction
   /// (a blank stretch of corridor): then the match keeps the prior along it.
   bool blankAlongCorridor(const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior) const;
@@ -183,6 +185,7 @@ class LaserOdometry {
   /// Keeps the poses of matches outside blank stretches; at a blank stretch's first scan, the held speed.
   void seeAlongCorridor(double stamp, const OdometryUpdate& u);
   void holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d& weak);
+  /// The scan's match against the local map from `prior`, into u.match (and u.points_used).
   void matchToLocalMap(const PreprocessedScan& scan, const LaserMount& mount,
                        const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior, double dt,
                        OdometryUpdate& u);
@@ -213,7 +216,7 @@ class LaserOdometry {
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  ///< base frame, per second
   std::deque<Keyframe> keyframes_;
-  // Blank stretches of corridor (doc/algorithms.md §5, doc/experiments.md "Blank stretches told by the
+  // Blank stretches of corridor (doc/algorithms.md §6, doc/experiments.md "Blank stretches told by the
   // surfaces facing along them"). Less than this much surface facing along the corridor (m) is a blank
   // stretch: about one door jamb's face; on the generated buildings' blank corridors the scans show none.
   static constexpr double kMinFacingLength = 0.1;

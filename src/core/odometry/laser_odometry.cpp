@@ -3,8 +3,6 @@
 #include <cmath>
 #include <limits>
 
-#include <Eigen/Eigenvalues>
-
 #include "laser_dpslam/odometry/wheel_motion.h"
 #include "laser_dpslam/scan/facing_surfaces.h"
 #include "laser_dpslam/scan/voxel_filter.h"
@@ -101,8 +99,8 @@ bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_point
   return true;
 }
 
-// The points of `seen` (stamped poses, oldest first) from the first at or after `from` to the last at or
-// before `to`, when they span at least 40 % of the interval.
+// The poses of `seen` (stamped, oldest first) from the first at or after `from` to the last at or before `to`,
+// and the time between them, when it spans at least 40 % of the interval.
 using StampedPoses = std::deque<std::pair<double, Pose2D>>;
 bool spanOf(const StampedPoses& seen, double from, double to, const Pose2D** a, const Pose2D** b, double* dt) {
   const std::pair<double, Pose2D>* first = nullptr;
@@ -321,11 +319,10 @@ void LaserOdometry::matchToLocalMap(const PreprocessedScan& scan, const LaserMou
                                  ? 0.5 * config_.prior_acceleration * dt * dt
                                  : -1.0;
   // The wheels measure the motion: no release from their prior, and along a corridor the match keeps it.
-  // In a blank stretch of corridor nothing measures the motion along it either.
-  // Only for short-range lasers, as the corridor hold (degenerate_velocity_max_range): a long-range one sees
-  // a corridor's ends, and its returns at range lie farther apart than facingLength fits a surface over.
-  const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
-                           scan.range_max <= config_.degenerate_velocity_max_range;
+  // In a blank stretch of corridor nothing measures the motion along it either (short-range lasers only: a
+  // long-range one sees a corridor's ends, and its returns at range lie farther apart than facingLength fits
+  // a surface over).
+  const bool short_range = shortRange(scan);
   u.velocity_held_blank = short_range && !u.wheel_prior && blankAlongCorridor(base_points, prior);
   const bool hold = u.wheel_prior || u.velocity_held_blank;
   const bool may_release = !hold && config_.prior_release_speed > 0.0 &&
@@ -386,8 +383,7 @@ void LaserOdometry::updateVelocity(const PreprocessedScan& scan, const LaserMoun
   const double g = config_.velocity_gain;
   const Eigen::Vector2d before = velocity_.head<2>();
   velocity_.head<2>() = (1.0 - g) * before + g * measured.head<2>();
-  const bool short_range = config_.degenerate_velocity_max_range <= 0.0 ||
-                           scan.range_max <= config_.degenerate_velocity_max_range;
+  const bool short_range = shortRange(scan);
   // A released prior was refuted by the scan: nothing left to hold.
   if (u.match.prior_released) constrained_stamp_ = kNoConstrainedMatch;
   if (short_range && u.match.degenerate) velocityAlongCorridor(scan, mount, previous, dt, before, measured, u);
@@ -430,6 +426,10 @@ void LaserOdometry::velocityAlongCorridor(const PreprocessedScan& scan, const La
   }
 }
 
+bool LaserOdometry::shortRange(const PreprocessedScan& scan) const {
+  return config_.degenerate_velocity_max_range <= 0.0 || scan.range_max <= config_.degenerate_velocity_max_range;
+}
+
 bool LaserOdometry::blankAlongCorridor(const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior) const {
   if (last_weak_.squaredNorm() == 0.0) return false;  // the last match constrained every direction
   const Eigen::Vector2d w = Pose2D(0.0, 0.0, prior.theta).rotation().transpose() * last_weak_;
@@ -453,9 +453,9 @@ void LaserOdometry::limitDegenerateStep(const Pose2D& prior, double prior_sigma,
 }
 
 void LaserOdometry::seeAlongCorridor(double stamp, const OdometryUpdate& u) {
+  while (!seen_along_.empty() && seen_along_.front().first < stamp - kHoldSpeedWindow) seen_along_.pop_front();
   if (u.velocity_held_blank && !was_blank_) holdSpeedFromSeenMatches(stamp, u.match.weak_direction);
   if (!u.velocity_held_blank) seen_along_.push_back({stamp, pose_});
-  while (!seen_along_.empty() && seen_along_.front().first < stamp - kHoldSpeedWindow) seen_along_.pop_front();
   was_blank_ = u.velocity_held_blank;
 }
 
@@ -463,8 +463,7 @@ void LaserOdometry::holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d
   // A blank stretch starts: the speed it keeps along the corridor is fitted to the last seconds of matches
   // that saw something along it, rather than the last few scans' smoothed velocity (a few per cent off,
   // which a 40 m corridor turns into metres). The window halves until its two halves agree (no acceleration
-  // inside it); with no such window the smoothed velocity stays.
-  while (!seen_along_.empty() && seen_along_.front().first < stamp - kHoldSpeedWindow) seen_along_.pop_front();
+  // inside it); with no such window the smoothed velocity stays. seen_along_ holds the last kHoldSpeedWindow s.
   const Eigen::Matrix2d frame = pose_.rotation();
   const Eigen::Vector2d w = frame.transpose() * weak;  // base frame
   const double end = seen_along_.empty() ? stamp : seen_along_.back().first;
