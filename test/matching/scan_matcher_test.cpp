@@ -200,20 +200,18 @@ TEST(ScanMatcher, SoftPriorHoldsTheCorridorDirectionAndYieldsToTheData) {
   EXPECT_NEAR(with_prior.pose.y, free_match.pose.y, 0.01);
 }
 
-// The old hard rule (keep_prior_when_degenerate): along the corridor the result is the prior exactly, across
-// it the walls decide.
+// The hard corridor rule (hold_prior_when_degenerate: wheel odometry, a blank stretch): along the corridor the
+// result is the prior exactly, across it the walls decide.
 TEST(ScanMatcher, HardCorridorRuleKeepsThePriorAlongTheCorridor) {
   const FloorPlan corridor = test::planFromBoxes(40.0, 3.0, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.9, 40.0, 3.0}});
   ScanSimulator sim(corridor, ScanSimulatorConfig(), 5);
-  ScanMatcherConfig c;
-  c.keep_prior_when_degenerate = true;
-  ScanMatcher m(c);
+  ScanMatcher m;
   m.setReference(scanAt(sim, Pose2D(20.0, 1.5, 0.0)));
   const auto pts = scanAt(sim, Pose2D(20.1, 1.53, 0.0));
   for (int seed = 0; seed < 5; ++seed) {
     std::mt19937_64 rng(seed);
     const Pose2D prior(0.17, 0.0, 0.0);
-    const MatchResult r = m.match(pts, pts, prior, rng, 0.0);
+    const MatchResult r = m.match(pts, pts, prior, rng, 0.0, false, true);
     ASSERT_TRUE(r.valid);
     EXPECT_NEAR(r.pose.x, prior.x, 1e-3) << "seed " << seed;
     EXPECT_NEAR(r.pose.y, 0.03, 0.01) << "seed " << seed;

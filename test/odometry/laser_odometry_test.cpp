@@ -225,64 +225,34 @@ TEST(LaserOdometry, SmoothedVelocityShrinksTheCorridorLag) {
   RecordProperty("last_motion_mean_mm", static_cast<int>(1000.0 * last_motion / 3.0));
 }
 
-// match_range_margin: the points within the margin of the effective range_max are left out of the match
-// (points_used counts the polish's points), all of them when fewer than min_points would remain.
-TEST(LaserOdometry, RangeMarginLeavesTheFarthestPointsOutOfTheMatch) {
-  const SimRun run = simulateLoop(1);
-  ScanPreprocessorConfig pc;
-  pc.max_range = 3.0;
-  const PreprocessedScan first = preprocessScan(run.scans[0], pc), second = preprocessScan(run.scans[1], pc);
-  ASSERT_DOUBLE_EQ(second.range_max, 3.0);
-  auto pointsUsed = [&](double margin) {
-    LaserOdometryConfig c;
-    c.match_range_margin = margin;
-    LaserOdometry odom(c);
-    odom.process(first, LaserMount());
-    const OdometryUpdate u = odom.process(second, LaserMount());
-    EXPECT_TRUE(u.ok) << toString(u.skip_reason);
-    return u.points_used;
-  };
-  const int all = static_cast<int>(second.points.size());
-  int beyond = 0;
-  for (double r : second.ranges) beyond += r > 3.0 - 0.5 ? 1 : 0;
-  ASSERT_GT(beyond, 0);
-  ASSERT_GE(all - beyond, LaserOdometryConfig().min_points);
-  EXPECT_EQ(pointsUsed(0.0), all);
-  EXPECT_EQ(pointsUsed(0.5), all - beyond);
-  EXPECT_EQ(pointsUsed(2.99), all);  // nothing within 1 cm: match everything rather than nothing
-}
-
 // The same corridor, the rest of that lag. Where the match is degenerate its motion along the corridor is the
 // prior plus the NDT score's ripple (the score of points on a wall varies with their place in the cells);
 // smoothing that into the velocity with the full gain lets the estimate stall for seconds.
-// degenerate_velocity_gain (0.1 for lasers up to 10 m) averages it over more scans. Final error, seeds 1-6
-// (m), with match_range_margin 0.5 and without the hold, the flow and the prior release: 1.486, 0.448, 0.671,
-// 0.182, 1.659, 0.284; with degenerate_velocity_gain 0.1 as well: 0.662, 0.664, 0.508, 0.252, 0.928, 0.185 (a
-// scan's ripple is not a constant bias, so a few seeds lose: the sum is what it shrinks). With the defaults'
-// hold the gain changes nothing on this corridor; it still helps the demo bag's and the whole loop's odometry
-// (doc/experiments.md), but it costs CSAIL (doc/tuning.md).
+// degenerate_velocity_gain (0.1 for lasers up to 10 m) averages it over more scans. Without the hold, the
+// flow and the prior release, the final errors of seeds 1-6 sum to 0.451 m without the gain and 0.376 m with it
+// (−17 %; a scan's ripple is not a constant bias, so single seeds may lose: the sum is what it shrinks). With
+// the defaults' hold the gain changes nothing on this corridor; it still helps the demo bag's and the whole
+// loop's odometry (doc/experiments.md), but it costs CSAIL (doc/tuning.md).
 TEST(LaserOdometry, DegenerateVelocityGainShrinksTheCorridorStall) {
-  LaserOdometryConfig margin, with_gain;
-  margin.match_range_margin = 0.5;
-  margin.degenerate_velocity_gain = -1.0;
-  margin.prior_release_speed = 0.0;  // measured before it (its own test below)
-  with_gain.match_range_margin = 0.5;
+  LaserOdometryConfig without, with_gain;
+  without.degenerate_velocity_gain = -1.0;
+  without.prior_release_speed = 0.0;  // measured before it (its own test below)
   with_gain.degenerate_velocity_gain = 0.1;
   with_gain.prior_release_speed = 0.0;
-  margin.degenerate_hold_time = with_gain.degenerate_hold_time = 0.0;  // measured before it (its own test below)
-  margin.range_flow_gain = with_gain.range_flow_gain = 0.0;            // likewise
-  double e_margin = 0.0, e_gain = 0.0;
+  without.degenerate_hold_time = with_gain.degenerate_hold_time = 0.0;  // measured before it (its own test below)
+  without.range_flow_gain = with_gain.range_flow_gain = 0.0;            // likewise
+  double e_without = 0.0, e_gain = 0.0;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
-    e_margin += westCorridorFinalError(margin, seed);
+    e_without += westCorridorFinalError(without, seed);
     e_gain += westCorridorFinalError(with_gain, seed);
   }
-  EXPECT_LT(e_gain, 0.7 * e_margin);
+  EXPECT_LT(e_gain, 0.9 * e_without);
   // Only for short-range lasers: with a laser longer than degenerate_velocity_max_range the gain is not used
   // (nor the blank-stretch hold, which the same range gates: both configs are gated here).
-  LaserOdometryConfig gated = with_gain, gated_margin = margin;
-  gated.degenerate_velocity_max_range = gated_margin.degenerate_velocity_max_range = 5.0;  // the URG-04LX: 5.6 m
-  EXPECT_EQ(westCorridorFinalError(gated, 1), westCorridorFinalError(gated_margin, 1));
-  RecordProperty("margin_only_mean_mm", static_cast<int>(1000.0 * e_margin / 6.0));
+  LaserOdometryConfig gated = with_gain, gated_without = without;
+  gated.degenerate_velocity_max_range = gated_without.degenerate_velocity_max_range = 5.0;  // the URG-04LX: 5.6 m
+  EXPECT_EQ(westCorridorFinalError(gated, 1), westCorridorFinalError(gated_without, 1));
+  RecordProperty("without_gain_mean_mm", static_cast<int>(1000.0 * e_without / 6.0));
   RecordProperty("with_gain_mean_mm", static_cast<int>(1000.0 * e_gain / 6.0));
 }
 

@@ -25,7 +25,6 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(o.keyframe_overlap_drop, d.keyframe_overlap_drop);
   EXPECT_EQ(o.prior_acceleration, d.prior_acceleration);
   EXPECT_EQ(o.velocity_gain, d.velocity_gain);
-  EXPECT_EQ(o.match_range_margin, d.match_range_margin);
   EXPECT_EQ(o.degenerate_velocity_gain, d.degenerate_velocity_gain);
   EXPECT_EQ(o.degenerate_velocity_max_range, d.degenerate_velocity_max_range);
   EXPECT_EQ(o.degenerate_hold_time, d.degenerate_hold_time);
@@ -58,8 +57,6 @@ TEST(OdometryParameters, ShippedYamlEqualsTheBuiltInDefaults) {
   EXPECT_EQ(m.degeneracy_ratio, dm.degeneracy_ratio);
   EXPECT_EQ(m.degenerate_sigma, dm.degenerate_sigma);
   EXPECT_EQ(m.degenerate_sigma_with_prior, dm.degenerate_sigma_with_prior);
-  EXPECT_EQ(m.keep_prior_when_degenerate, dm.keep_prior_when_degenerate);
-  EXPECT_EQ(m.prior_sigma_xy, dm.prior_sigma_xy);
   EXPECT_EQ(m.weak_score, dm.weak_score);
   EXPECT_EQ(m.weak_matched_fraction, dm.weak_matched_fraction);
   EXPECT_EQ(m.weak_inflation, dm.weak_inflation);
@@ -93,7 +90,7 @@ TEST(OdometryParameters, ValuesAreReadAndBadOnesNamed) {
   EXPECT_NE(message("resampling: random").find("saliency"), std::string::npos);
   EXPECT_NE(message("ndt_cell_sizes: [1.0, -0.5]").find("ndt_cell_sizes"), std::string::npos);
   EXPECT_NE(message("de_CR: 1.5").find("de_CR"), std::string::npos);
-  EXPECT_NE(message("match_range_margin: -0.5").find("match_range_margin"), std::string::npos);
+  EXPECT_NE(message("keyframe_overlap_drop: -0.5").find("keyframe_overlap_drop"), std::string::npos);
   EXPECT_NE(message("degenerate_velocity_gain: 2").find("degenerate_velocity_gain"), std::string::npos);
   EXPECT_NE(message("degenerate_hold_time: -1").find("degenerate_hold_time"), std::string::npos);
   EXPECT_NE(message("range_flow_gain: 1.5").find("range_flow_gain"), std::string::npos);

@@ -36,7 +36,7 @@ const SimRun& loopRun() {
     r.truth = samplePath(repeatLoop(loop, 2), 10.0, PathConfig());
     ScanSimulator sim(room, ScanSimulatorConfig(), 21);
     // The odometry that feeds these DP-SLAM tests is pinned (its defaults of 2026-11-29: a 5-keyframe
-    // local map, no turn retry, 0.3 m along corridors, no match_range_margin, no degenerate_velocity_gain),
+    // local map, no turn retry, 0.3 m along corridors, no degenerate_velocity_gain),
     // so that they test the filter on a fixed input. With
     // 10 keyframes and the retry this loop's SLAM max error over filter seeds 1-5 was
     // 0.127/0.111/0.084/0.072/0.092 m against 0.104/0.099/0.085/0.090/0.074 m (same end errors, 0.018 m
@@ -45,7 +45,6 @@ const SimRun& loopRun() {
     odometry_config.local_map_keyframes = 5;
     odometry_config.matcher.rescue_margin = 0.0;
     odometry_config.matcher.degenerate_sigma_with_prior = 0.3;
-    odometry_config.match_range_margin = 0.0;
     odometry_config.degenerate_velocity_gain = -1.0;
     odometry_config.degenerate_hold_time = 0.0;
     odometry_config.range_flow_gain = 0.0;

@@ -42,15 +42,10 @@ struct ScanMatcherConfig {
   double min_sigma_theta = 0.002;       ///< rad, standard deviation floor
   double degeneracy_ratio = 0.02;       ///< eigenvalue of H's translation block below this × its largest: degenerate
   double degenerate_sigma = 0.3;        ///< m, σ added along a degenerate translation direction
-  /// m, the same when the soft motion prior took part in the match (prior_sigma_xy > 0): the prior then
+  /// m, the same when the soft motion prior took part in the match (match()'s prior_sigma_xy > 0): the prior then
   /// holds that direction to about its own σ per scan, and a σ of 0.3 m per scan let the DP-SLAM's
   /// particles random-walk along corridors (doc/benchmarks.md).
   double degenerate_sigma_with_prior = 0.02;
-  bool keep_prior_when_degenerate = false;  ///< along a degenerate direction keep the motion prior exactly (superseded by the soft prior of LaserOdometryConfig::prior_acceleration)
-  /// m; > 0: the Newton polish minimises h + α/2·|t − t_prior|²/σ² (a Gaussian motion prior of this σ on the
-  /// translation, in h's units through Σ = α·H⁻¹): where the scan constrains the pose the data wins, along a
-  /// corridor the prior does, with no hard degeneracy threshold. 0 = off.
-  double prior_sigma_xy = 0.0;
   double weak_score = 0.25;             ///< score per point (0…1) below which the match is weak
   double weak_matched_fraction = 0.5;   ///< matched fraction below which the match is weak
   double weak_inflation = 10.0;         ///< covariance multiplier for a weak match
@@ -105,12 +100,14 @@ class ScanMatcher {
   /// DE searches with `search_points` (a resampled subset: the cost is evaluated hundreds of times);
   /// the Newton polish, the covariance and the quality use `polish_points` (more points: the precision
   /// of the estimate grows with them, and Newton needs only a few evaluations).
-  /// `prior_sigma_xy` < 0: the config's; otherwise this scan's σ of the motion prior (see the config).
+  /// `prior_sigma_xy` > 0: the Newton polish minimises h + α/2·|t − t_prior|²/σ² (a Gaussian motion prior of
+  /// this σ on the translation, in h's units through Σ = α·H⁻¹): where the scan constrains the pose the data
+  /// wins, along a corridor the prior does, with no hard degeneracy threshold. ≤ 0: no prior.
   /// `allow_prior_release`: a degenerate match may drop that prior (ScanMatcherConfig::prior_release_margin).
-  /// `hold_prior_when_degenerate`: along a degenerate direction keep the prior exactly, as
-  /// keep_prior_when_degenerate does, for this match (the prior is a measurement: wheel odometry).
+  /// `hold_prior_when_degenerate`: along a degenerate direction keep the prior exactly (the prior is a
+  /// measurement there: wheel odometry, or a blank stretch of corridor).
   MatchResult match(const std::vector<Eigen::Vector2d>& search_points, const std::vector<Eigen::Vector2d>& polish_points,
-                    const Pose2D& prior, std::mt19937_64& rng, double prior_sigma_xy = -1.0,
+                    const Pose2D& prior, std::mt19937_64& rng, double prior_sigma_xy = 0.0,
                     bool allow_prior_release = false, bool hold_prior_when_degenerate = false) const;
 
   /// Newton polish only, from `start`, on resolution level `level` (exposed for tests). With `basis`
@@ -118,7 +115,7 @@ class ScanMatcher {
   /// score (without the prior's term) at the returned pose, with derivatives.
   Pose2D polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
                 int* iterations = nullptr, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis = nullptr,
-                const Pose2D* prior = nullptr, double prior_sigma_xy = -1.0, NdtScore* final_score = nullptr) const;
+                const Pose2D* prior = nullptr, double prior_sigma_xy = 0.0, NdtScore* final_score = nullptr) const;
 
   const ScanMatcherConfig& config() const { return config_; }
   const NdtGrid& grid(std::size_t level) const { return grids_.at(level); }
@@ -158,15 +155,10 @@ class ScanMatcher {
   /// True when H's translation block has a direction the scan barely constrains (degeneracy_ratio); that
   /// direction (unit) into *weak.
   bool degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* weak) const;
-  /// The σ of the motion prior in effect: this scan's when given (>= 0), the config's otherwise.
-  double priorSigma(double prior_sigma_xy) const {
-    return prior_sigma_xy >= 0.0 ? prior_sigma_xy : config_.prior_sigma_xy;
-  }
   /// Weight w of the motion prior's penalty ½·w·|xy − prior|² in h's units (Σ = α·H⁻¹ ⇒ information α⁻¹·H);
   /// 0 without a prior.
   double priorWeight(double prior_sigma_xy) const {
-    const double sigma = priorSigma(prior_sigma_xy);
-    return sigma > 0.0 ? config_.covariance_scale / (sigma * sigma) : 0.0;
+    return prior_sigma_xy > 0.0 ? config_.covariance_scale / (prior_sigma_xy * prior_sigma_xy) : 0.0;
   }
 
   ScanMatcherConfig config_;

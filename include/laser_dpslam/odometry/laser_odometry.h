@@ -31,7 +31,7 @@ struct LaserOdometryConfig {
   int local_map_keyframes = 10;      ///< keyframes in the local map (10 × 0.25 m: scripts/benchmark_loop.sh, CSAIL)
   /// m/s²; > 0: the constant-velocity prior enters the Newton polish as a Gaussian on the translation with
   /// σ = ½·a·dt² (the displacement an unmodelled acceleration a causes over the scan interval dt), see
-  /// ScanMatcherConfig::prior_sigma_xy. 0 = off.
+  /// ScanMatcher::match. 0 = off.
   double prior_acceleration = 2.0;
   /// (0, 1]: weight of the newest scan-to-scan translation velocity in the constant-velocity prior
   /// (exponential smoothing per scan; 1 = the last motion only). 0.3 from scripts/benchmark_loop.sh and CSAIL.
@@ -40,13 +40,6 @@ struct LaserOdometryConfig {
   /// last keyframe: new structure came into view that the local map lacks (0 = off). Without it a robot whose
   /// estimate stalls in a corridor never takes the keyframe that would show it the wall ahead.
   double keyframe_overlap_drop = 0.1;
-  /// m; > 0: scan points with a range above (range_max − this) are left out of the match (they still
-  /// join keyframes). The local map was seen from up to a keyframe spacing behind, so the current scan's
-  /// farthest points reach past the map's edge; where nothing else fixes the position along a corridor
-  /// they pull the match back towards the map. 0.5 helped on the simulated loop building (scripts/
-  /// benchmark_loop.sh) but doubled the share of degenerate matches on the real 8 m log loop5 (those far points
-  /// are often a corridor's end), so it is opt-in. 0 = off.
-  double match_range_margin = 0.0;
   /// [0, 1]: velocity_gain along the unconstrained direction of a degenerate match (corridor), where the
   /// match's motion is mostly the prior plus the score's ripple; < velocity_gain averages that ripple
   /// over more scans. Negative = velocity_gain. Applies only to short-range lasers (below).

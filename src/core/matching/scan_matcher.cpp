@@ -265,7 +265,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   const bool de = config_.use_de && !raster_.empty();
   NdtScore s;
   Pose2D pose = polishAll(in, de ? deSearch(in, Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng, r) : prior, &s, r);
-  const double prior_sigma = priorSigma(prior_sigma_xy);
+  const double prior_sigma = std::max(0.0, prior_sigma_xy);
   if (de && prior_sigma > 0.0 && std::hypot(pose.x - prior.x, pose.y - prior.y) > 3.0 * prior_sigma) {
     // The polish minimises h plus the soft prior, but DE searched h alone (on the raster) and may hand it a
     // basin far from the prior (a corridor's flat score, a false optimum 0.2 m back). Polish from the prior
@@ -279,7 +279,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     // (Without DE the match already started from the prior: nothing to retry.)
     rescueWeak(in, rng, &pose, &s, r);
   }
-  if (config_.keep_prior_when_degenerate || hold_prior_when_degenerate) {
+  if (hold_prior_when_degenerate) {
     // In a corridor the score is flat along it: DE and Newton wander there, while the constant-velocity
     // prior is the better guess. Keep the prior along the weak translation direction, re-polish across it
     // (LOAM-style solution remapping, Zhang et al. 2016).

@@ -76,29 +76,6 @@ constexpr std::size_t kMaxWheelSamples = 8192;
 constexpr double kHeldSpeedSigma = 0.02;
 constexpr double kHeldMinSpeedSigma = 0.005;  // m/s
 
-// The scan without its points beyond (range_max − margin), into *out; false (out untouched) when nothing
-// would be left out or fewer than min_points would remain (open space: match everything).
-bool trimToMatchRange(const PreprocessedScan& scan, double margin, int min_points, PreprocessedScan* out) {
-  if (margin <= 0.0 || scan.range_max <= margin) return false;
-  const double limit = scan.range_max - margin;
-  std::size_t keep = 0;
-  for (double r : scan.ranges) keep += r <= limit ? 1 : 0;
-  if (keep == scan.ranges.size() || static_cast<int>(keep) < min_points) return false;
-  *out = scan;
-  out->points.clear();
-  out->beams.clear();
-  out->ranges.clear();
-  out->angles.clear();
-  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
-    if (scan.ranges[i] > limit) continue;
-    out->points.push_back(scan.points[i]);
-    out->beams.push_back(scan.beams[i]);
-    out->ranges.push_back(scan.ranges[i]);
-    out->angles.push_back(scan.angles[i]);
-  }
-  return true;
-}
-
 // The poses of `seen` (stamped, oldest first) from the first at or after `from` to the last at or before `to`,
 // and the time between them, when it spans at least 40 % of the interval.
 using StampedPoses = std::deque<std::pair<double, Pose2D>>;
@@ -302,17 +279,14 @@ void LaserOdometry::start(const PreprocessedScan& scan, const LaserMount& mount,
 void LaserOdometry::matchToLocalMap(const PreprocessedScan& scan, const LaserMount& mount,
                                     const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior, double dt,
                                     OdometryUpdate& u) {
-  PreprocessedScan trimmed;
-  const bool trim = trimToMatchRange(scan, config_.match_range_margin, config_.min_points, &trimmed);
-  const PreprocessedScan& near = trim ? trimmed : scan;
   const std::vector<Eigen::Vector2d> match_points = mount.apply(
-      resampleScan(near, config_.resampling, static_cast<std::size_t>(std::max(1, config_.resampling_budget)),
+      resampleScan(scan, config_.resampling, static_cast<std::size_t>(std::max(1, config_.resampling_budget)),
                    config_.saliency, config_.seed + scan_count_));
   const std::vector<Eigen::Vector2d> polish_points =
-      config_.polish_budget > 0 && static_cast<int>(near.points.size()) > config_.polish_budget
-          ? mount.apply(resampleScan(near, ResamplingMethod::kUniform, static_cast<std::size_t>(config_.polish_budget),
+      config_.polish_budget > 0 && static_cast<int>(scan.points.size()) > config_.polish_budget
+          ? mount.apply(resampleScan(scan, ResamplingMethod::kUniform, static_cast<std::size_t>(config_.polish_budget),
                                      config_.saliency, 0))
-          : (trim ? mount.apply(near.points) : base_points);
+          : base_points;
   ++scan_count_;
   u.points_used = static_cast<int>(polish_points.size());
   const double prior_sigma = config_.prior_acceleration > 0.0 && dt > 0.0 && dt <= config_.max_prior_gap

@@ -68,11 +68,6 @@ std::vector<Parameter<S>> frameScanAndLocalMapEntries() {
        kAdvanced},
       {"map_voxel", "local map", FIELD(odometry.map_voxel), "m", atLeast(0), "voxel filter of the local map's points",
        kAdvanced},
-      {"match_range_margin", "local map", FIELD(odometry.match_range_margin), "m", atLeast(0),
-       "scan points farther than the effective range_max minus this join the local map but not the match (they "
-       "reach past the map's edge and pull the match back along corridors); 0 = off. 0.5 helps the simulated loop "
-       "building but doubles the degenerate matches on the real 8 m log loop5, so opt-in",
-       kAdvanced},
       {"wall_alignment_min_strength", "local map", FIELD(odometry.wall_alignment_min_strength), "-",
        closedInterval(0, 1),
        "align_to_walls only when the first scan's chords agree at least this much (1 = all along one direction or "
@@ -151,8 +146,6 @@ std::vector<Parameter<S>> motionPriorEntries() {
        "along corridors; when DE ends more than 3 sigma from the prior the polish also starts from the prior and "
        "the lower value wins); 0 = off",
        kAdvanced},
-      {"prior_sigma_xy", "motion prior", FIELD(odometry.matcher.prior_sigma_xy), "m", atLeast(0),
-       "fixed sigma of that prior, used only when prior_acceleration is 0; 0 = off", kAdvanced},
       {"velocity_gain", "motion prior", FIELD(odometry.velocity_gain), "-", leftOpenInterval(0, 1),
        "weight of the newest scan's translation velocity in the prior's velocity (exponential smoothing; 1 = the "
        "last motion only): small per-match biases along corridors do not add up",
@@ -191,11 +184,6 @@ std::vector<Parameter<S>> motionPriorEntries() {
        kAdvanced},
       {"prior_release_sigmas", "motion prior", FIELD(odometry.matcher.prior_release_sigmas), "-", atLeast(0),
        "... and lie more than this many prior sigmas away along the corridor", kAdvanced},
-      {"keep_prior_when_degenerate", "motion prior", FIELD(odometry.matcher.keep_prior_when_degenerate), "bool",
-       anyValue(),
-       "the old hard rule: keep the prior exactly along a degenerate direction (it ran away in the loop "
-       "building's corridors; prior_acceleration replaces it)",
-       kAdvanced},
   };
 }
 
