@@ -192,43 +192,45 @@ TEST(LaserOdometry, MountedLaserGivesTheBasePose) {
   EXPECT_NEAR(odom.pose().theta, expected.theta, 0.01);
 }
 
-// The loop building's west corridor (westCorridorFinalError). Between the niche and the south wall only weak structure constrains the pose
-// along it; taking the last motion as the prior's velocity lets the matches' small biases add up into a lag of
-// about 1 m (maps too short, the issue-4 failure). Smoothing the velocity (velocity_gain) at least halves it.
-// Measured with seeds 1-4 (final error, m): gain 1: 1.29, 0.97, 1.22, 0.79; gain 0.3: 0.45, 0.21, 0.42, 0.44.
-// Not fixed by it: starting from rest 2 m further south (the north wall 3.3 m away) stalls for seconds with
-// any gain. The drive starts exactly parallel to the walls, which lie on the plan's 5 cm lattice: the case
-// where align_to_walls (on by default since 2026-12-03) costs, its frame being ~0.3° off the
-// walls (this corridor from rest, 10 starts shifted 0-5 cm: 0.154 m mean final error with it off, 0.273 m
-// on; the loop started a few degrees off the walls, as a real run is, gains from it: doc/tuning.md). The
-// smoothing is measured in the frame along the walls.
-TEST(LaserOdometry, SmoothedVelocityShrinksTheCorridorLag) {
-  auto finalError = [](double gain, std::uint64_t seed) {
-    LaserOdometryConfig c;
-    c.align_to_walls = false;
-    c.velocity_gain = gain;
-    c.degenerate_velocity_gain = -1.0;  // the same gain along the corridor (that one has its own test below)
-    c.prior_release_speed = 0.0;        // and no prior release (its own test below)
-    c.degenerate_hold_time = 0.0;       // nor the hold (its own test below)
-    c.range_flow_gain = 0.0;            // nor the range flow
-    return westCorridorFinalError(c, seed);
-  };
-  double smoothed = 0.0, last_motion = 0.0;
-  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    const double s = finalError(LaserOdometryConfig().velocity_gain, seed), l = finalError(1.0, seed);
-    EXPECT_LT(s, l) << "seed " << seed;
-    smoothed += s;
-    last_motion += l;
+// velocity_gain: the prior's translation velocity is an exponential smoothing of the matched motions
+// (v ← (1 − g)·v + g·Δ/dt), its rotation the last motion. Taking the last motion as the velocity feeds each
+// match's small bias along a corridor straight back into the next prior. Its effect is a distribution's,
+// not one corridor's: on the generated buildings (scripts/benchmark_buildings.sh --odometry-only, bench
+// list, search seeds 1 / 2) the laser odometry's drift median is 0.33 / 0.34 % with g = 0.3 and 0.54 /
+// 0.65 % with g = 1, p90 0.93 / 1.32 % against 1.51 / 3.12 % (doc/experiments.md). Here: the rule itself,
+// on the furnished-room loop, where every match constrains the pose (the corridor rules stay out).
+TEST(LaserOdometry, VelocityIsTheSmoothedMatchedMotion) {
+  const SimRun run = simulateLoop(2);
+  LaserOdometryConfig c;
+  const double g = c.velocity_gain;
+  ASSERT_GT(g, 0.0);
+  ASSERT_LT(g, 1.0);
+  LaserOdometry odom(c);
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  double last_stamp = 0.0;
+  int checked = 0;
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    const OdometryUpdate u = odom.process(preprocessScan(run.scans[i], ScanPreprocessorConfig()), LaserMount());
+    ASSERT_TRUE(u.ok) << "scan " << i;
+    if (i > 0 && !u.match.degenerate) {
+      const double dt = u.stamp - last_stamp;
+      const Eigen::Vector3d measured = Eigen::Vector3d(u.delta.x, u.delta.y, u.delta.theta) / dt;
+      const Eigen::Vector2d expected = (1.0 - g) * v.head<2>() + g * measured.head<2>();
+      EXPECT_NEAR(u.velocity.x(), expected.x(), 1e-9) << "scan " << i;
+      EXPECT_NEAR(u.velocity.y(), expected.y(), 1e-9) << "scan " << i;
+      EXPECT_NEAR(u.velocity.z(), measured.z(), 1e-9) << "scan " << i;
+      ++checked;
+    }
+    v = u.velocity;
+    last_stamp = u.stamp;
   }
-  EXPECT_LT(smoothed, 0.5 * last_motion);
-  RecordProperty("smoothed_mean_mm", static_cast<int>(1000.0 * smoothed / 3.0));
-  RecordProperty("last_motion_mean_mm", static_cast<int>(1000.0 * last_motion / 3.0));
+  EXPECT_GT(checked, static_cast<int>(run.scans.size()) / 2);
 }
 
-// The same corridor, the rest of that lag. Where the match is degenerate its motion along the corridor is the
-// prior plus the NDT score's ripple (the score of points on a wall varies with their place in the cells);
-// smoothing that into the velocity with the full gain lets the estimate stall for seconds.
-// degenerate_velocity_gain (0.1 for lasers up to 10 m) averages it over more scans. Without the hold, the
+// The loop building's west corridor (westCorridorFinalError), from rest at its north end to its south end.
+// Where the match is degenerate its motion along the corridor is the prior plus the NDT score's ripple (the
+// score of points on a wall varies with their place in the cells); smoothing that into the velocity with the
+// full gain lets the estimate stall for seconds. degenerate_velocity_gain (0.1 for lasers up to 10 m) averages it over more scans. Without the hold, the
 // flow and the prior release, the final errors of seeds 1-6 sum to 0.451 m without the gain and 0.376 m with it
 // (−17 %; a scan's ripple is not a constant bias, so single seeds may lose: the sum is what it shrinks). With
 // the defaults' hold the gain changes nothing on this corridor; it still helps the demo bag's and the whole
@@ -261,7 +263,8 @@ TEST(LaserOdometry, DegenerateVelocityGainShrinksTheCorridorStall) {
 // slows the estimated speed scan after scan (the loop's odometry lost 0.10-0.36 m there in every run,
 // scripts/benchmark_loop.sh). degenerate_hold_time keeps the speed measured where the last match fixed every
 // direction, and where no surface faces along the corridor the match keeps the motion prior along it.
-// Measured in the frame along the walls, as the smoothing above. Final error, seeds 1-3 (m): without
+// Measured in the frame along the walls (the corridor's walls lie on the plan's 5 cm lattice, where
+// align_to_walls' frame, ~0.3° off them, costs: doc/tuning.md). Final error, seeds 1-3 (m): without
 // degenerate_hold_time 0.011, 0.021, 0.034; with 0.010, 0.007, 0.025.
 TEST(LaserOdometry, DegenerateHoldKeepsTheSpeedThroughTheCorridor) {
   LaserOdometryConfig hold, no_hold;
