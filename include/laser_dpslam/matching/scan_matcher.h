@@ -34,7 +34,9 @@ struct ScanMatcherConfig {
 
   // Newton polish on h (doc/algorithms.md §2).
   int newton_iterations = 10;         ///< per resolution
-  double newton_tolerance = 1e-5;     ///< m / rad, step size at which Newton stops
+  /// m / rad, step size at which Newton stops: 0.1 mm is a fiftieth of the 5 mm σ floor, and 1e-5 cost 13 %
+  /// more instructions for no gain on the generated buildings (doc/experiments.md).
+  double newton_tolerance = 1e-4;
 
   // Covariance and quality.
   double covariance_scale = 4.0;        ///< α in Σ = α·H⁻¹ + Σ_min (h is not a normalised likelihood)
