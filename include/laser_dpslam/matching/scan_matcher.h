@@ -34,7 +34,7 @@ struct ScanMatcherConfig {
 
   // Newton polish on h (doc/algorithms.md §2).
   int newton_iterations = 10;         ///< per resolution
-  /// m / rad, step size at which Newton stops: 0.1 mm is a fiftieth of the 5 mm σ floor, and 1e-5 cost 13 %
+  /// m / rad, step size at which Newton stops: 0.1 mm is a fiftieth of the 5 mm σ floor, and 1e-5 took 15 %
   /// more instructions for no gain on the generated buildings (doc/experiments.md).
   double newton_tolerance = 1e-4;
 
