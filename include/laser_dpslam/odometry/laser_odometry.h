@@ -77,7 +77,7 @@ struct LaserOdometryConfig {
   /// more along corridors: on the loop building started a few degrees off the walls, odometry ATE mean
   /// 0.187 m over seeds 1–12, 0.092 m with this on (doc/experiments.md). With walls lying exactly on a 5 cm
   /// lattice (a simulated plan, a start on a pixel) the estimate's ~0.3° error made the 0.05 m DE raster drift:
-  /// on by default together with ScanMatcherConfig::raster_resolution 0.03 (2026-12-03).
+  /// on by default together with ScanMatcherConfig::raster_resolution 0.03.
   bool align_to_walls = true;
   double wall_alignment_min_strength = 0.3;  ///< [0, 1]
   int min_points = 20;               ///< fewer valid points: the scan is skipped

@@ -50,8 +50,8 @@ std::vector<Parameter<S>> frameScanAndLocalMapEntries() {
       {"keyframe_distance", "local map", FIELD(odometry.keyframe_distance), "m", atLeast(0),
        "travel since the last keyframe before a new one joins the local map", kUser},
       {"local_map_keyframes", "local map", FIELD(odometry.local_map_keyframes), "keyframes", atLeast(1),
-       "how many recent keyframes make the local map each scan is matched against (10 x 0.25 m; 5 until "
-       "2026-11-30, see doc/benchmarks.md)",
+       "how many recent keyframes make the local map each scan is matched against (10 x 0.25 m; 5 drifted "
+       "about twice as much on the loop building, see doc/benchmarks.md)",
        kUser},
       {"align_to_walls", "local map", FIELD(odometry.align_to_walls), "bool", anyValue(),
        "match in a frame turned to the first scan's dominant wall direction (modulo 90 deg, from chords between "
@@ -129,7 +129,7 @@ std::vector<Parameter<S>> matchingEntries() {
        "Newton polish steps per NDT resolution", kAdvanced},
       {"rescue_margin", "matching", FIELD(odometry.matcher.rescue_margin), "-", atLeast(0),
        "retry a weak match from the prior and by DE over +-rescue_window_theta; keep a retry scoring this much "
-       "higher per point (turn failures; on since 2026-11-30, see doc/benchmarks.md); 0 = off",
+       "higher per point (turn failures, see doc/benchmarks.md); 0 = off",
        kAdvanced},
       {"rescue_window_theta", "matching", FIELD(odometry.matcher.rescue_window_theta), "rad", above(0),
        "half-width in heading of the retry's DE window (45 deg)", kAdvanced},
@@ -201,7 +201,10 @@ std::vector<Parameter<S>> covarianceEntries() {
       {"degenerate_sigma", "covariance", FIELD(odometry.matcher.degenerate_sigma), "m", above(0),
        "standard deviation added along a degenerate direction", kAdvanced},
       {"degenerate_sigma_with_prior", "covariance", FIELD(odometry.matcher.degenerate_sigma_with_prior), "m",
-       above(0), "the same when the soft motion prior held that direction (0.3 until 2026-11-30)", kAdvanced},
+       above(0),
+       "the same when the soft motion prior held that direction (0.3 let the SLAM's particles random-walk along "
+       "corridors)",
+       kAdvanced},
       {"weak_score", "covariance", FIELD(odometry.matcher.weak_score), "-", atLeast(0),
        "score per point (0..1) below which a match is weak", kAdvanced},
       {"weak_matched_fraction", "covariance", FIELD(odometry.matcher.weak_matched_fraction), "-", atLeast(0),

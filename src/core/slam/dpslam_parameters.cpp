@@ -129,13 +129,13 @@ std::vector<Parameter<S>> mapEntries() {
        "lower bound of that projection, |cos| of the beam's incidence on the surface", kAdvanced},
       {"cell_normal_min_cos", "map", FIELD(slam.cell_normal_min_cos), "-", closedInterval(0, 1),
        "a cell a beam stopped in keeps (per particle lineage) that surface's normal; distance through it counts "
-       "along that normal for every beam, |cos| bounded below by this; 0 = off (default since 2026-12-01, see "
+       "along that normal for every beam, |cos| bounded below by this; 0 = off (see "
        "doc/benchmarks.md)",
        kAdvanced},
       {"cell_surface_offsets", "map", FIELD(slam.cell_surface_offsets), "bool", anyValue(),
        "with cell normals: a cell also keeps where along its normal its surface lies (the mean of its stops), and "
        "a stop there is scored where the beam crosses that line instead of at the middle of its chord: walls are "
-       "seen to a fraction of a cell (default since 2026-12-03, see doc/benchmarks.md)",
+       "seen to a fraction of a cell (see doc/benchmarks.md)",
        kAdvanced},
   };
 }
