@@ -265,8 +265,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   const bool de = config_.use_de && !raster_.empty();
   NdtScore s;
   Pose2D pose = polishAll(in, de ? deSearch(in, Eigen::Vector3d(config_.window_xy, config_.window_xy, config_.window_theta), rng, r) : prior, &s, r);
-  const double prior_sigma = std::max(0.0, prior_sigma_xy);
-  if (de && prior_sigma > 0.0 && std::hypot(pose.x - prior.x, pose.y - prior.y) > 3.0 * prior_sigma) {
+  if (de && prior_sigma_xy > 0.0 && std::hypot(pose.x - prior.x, pose.y - prior.y) > 3.0 * prior_sigma_xy) {
     // The polish minimises h plus the soft prior, but DE searched h alone (on the raster) and may hand it a
     // basin far from the prior (a corridor's flat score, a false optimum 0.2 m back). Polish from the prior
     // too and keep the lower value of that same objective.
@@ -286,13 +285,13 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     keepPriorAlongWeak(in, &pose, &s, r);
   }
   Eigen::Vector2d weak;
-  if (allow_prior_release && prior_sigma > 0.0 && degenerate(s.hessian, &weak)) {
+  if (allow_prior_release && prior_sigma_xy > 0.0 && degenerate(s.hessian, &weak)) {
     // Along a corridor the soft prior holds the pose to the constant-velocity guess. When that guess is
     // wrong (the robot starts to move while the estimate says it is at rest), the velocity smoothing
     // follows the held motion only slowly and metres are lost in seconds (the loop building's start). The
     // scan then fits clearly better where it really is: polish again without the prior and take that
     // when it scores higher and lies well outside the prior's σ along the weak direction.
-    releasePrior(in, weak, prior_sigma, &pose, &s, r);
+    releasePrior(in, weak, prior_sigma_xy, &pose, &s, r);
   }
   r.pose = pose;
 
@@ -300,7 +299,7 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
   r.score_per_point = scorePerPoint(in, s);
   r.matched_fraction = static_cast<double>(s.matched) / in.n;
   r.weak = isWeak(in, s);
-  r.covariance = covarianceFrom(s.hessian, prior_sigma > 0.0, r);
+  r.covariance = covarianceFrom(s.hessian, prior_sigma_xy > 0.0, r);
   r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
   if (!r.valid) r.pose = prior;
   return r;

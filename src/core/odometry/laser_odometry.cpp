@@ -291,7 +291,7 @@ void LaserOdometry::matchToLocalMap(const PreprocessedScan& scan, const LaserMou
   u.points_used = static_cast<int>(polish_points.size());
   const double prior_sigma = config_.prior_acceleration > 0.0 && dt > 0.0 && dt <= config_.max_prior_gap
                                  ? 0.5 * config_.prior_acceleration * dt * dt
-                                 : -1.0;
+                                 : 0.0;
   // The wheels measure the motion: no release from their prior, and along a corridor the match keeps it.
   // In a blank stretch of corridor nothing measures the motion along it either (short-range lasers only: a
   // long-range one sees a corridor's ends, and its returns at range lie farther apart than facingLength fits
