@@ -29,12 +29,15 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <thread>
 
+#include "laser_dpslam/OdometryHold.h"
 #include "laser_dpslam/SaveMap.h"
 #include "laser_dpslam/common/newest_slot.h"
 #include "laser_dpslam/common/run_statistics.h"
@@ -64,6 +67,7 @@ class DpSlamNode {
     if (publish_particles_) particles_pub_ = nh.advertise<geometry_msgs::PoseArray>(names::kParticlesTopic, 1);
     scan_sub_ = nh.subscribe(names::kScanTopic, 20, &DpSlamNode::onScan, this);
     odom_sub_ = nh.subscribe(names::kOdomTopic, 50, &DpSlamNode::onOdom, this);
+    held_sub_ = nh.subscribe(names::kOdometryHoldTopic, 50, &DpSlamNode::onOdometryHold, this);
     map_srv_ = nh.advertiseService(names::kDynamicMapService, &DpSlamNode::onGetMap, this);
     save_srv_ = nh.advertiseService(names::kSaveMapService, &DpSlamNode::onSaveMap, this);
     updater_.setHardwareID("none");
@@ -118,6 +122,32 @@ class DpSlamNode {
       odom_newest_ns_ = stamp;
     }
     odom_arrived_.notify_all();
+  }
+
+  void onOdometryHold(const laser_dpslam::OdometryHold::ConstPtr& msg) {
+    const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
+    std::lock_guard<std::mutex> lock(odom_mutex_);
+    if (!held_.empty() && stamp <= held_.back().first) held_.clear();  // time went backwards: a new time line
+    HeldMotion h;
+    h.direction = Eigen::Vector2d(msg->direction.x, msg->direction.y);
+    h.speed_sigma = std::isfinite(msg->speed_sigma) ? msg->speed_sigma : 0.0;
+    if (!h.direction.allFinite()) return;
+    held_.emplace_back(stamp, h);
+    while (held_.size() > kHeldKept) held_.pop_front();
+  }
+
+  /// The odometry's held motion at the scan `stamp` (laser_odometry_node sends it before that scan's odom
+  /// message, which motionCovariance waited for), over the time since the last scan used; none when absent.
+  HeldMotion heldMotion(const ros::Time& stamp) {
+    const std::int64_t to = static_cast<std::int64_t>(stamp.toNSec());
+    std::lock_guard<std::mutex> lock(odom_mutex_);
+    HeldMotion out;
+    while (!held_.empty() && held_.front().first < to) held_.pop_front();
+    if (has_last_odom_ && !held_.empty() && held_.front().first == to) {
+      out = held_.front().second;
+      out.dt = (stamp - last_odom_stamp_).toSec();
+    }
+    return out;
   }
 
   /// Covariance of the odometry's motion from the last scan used to the one at `stamp` (zero without
@@ -210,6 +240,8 @@ class DpSlamNode {
     const Pose2D odom = poseFromMsg(odom_tf.transform);
     const Pose2D delta = has_last_odom_ ? between(last_odom_, odom) : Pose2D();
     const Eigen::Matrix3d delta_cov = motionCovariance(stamp);
+    const HeldMotion held = heldMotion(stamp);
+    if (held.active()) ROS_INFO_ONCE("dpslam_node: a blank stretch of corridor: the odometry's held speed (odom_held) reaches the filter");
     last_odom_ = odom;
     last_odom_stamp_ = stamp;
     has_last_odom_ = true;
@@ -219,7 +251,7 @@ class DpSlamNode {
     DpSlamUpdate u;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      u = slam_->process(stamp.toSec(), pre, mount, delta, delta_cov);
+      u = slam_->process(stamp.toSec(), pre, mount, delta, delta_cov, held);
     }
     if (!u.ok) {
       ROS_WARN_THROTTLE(5.0, "dpslam_node: scan skipped (%s)", u.skip_reason.c_str());
@@ -376,15 +408,17 @@ class DpSlamNode {
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::Publisher map_pub_, metadata_pub_, pose_pub_, path_pub_, particles_pub_;
-  ros::Subscriber scan_sub_, odom_sub_;
+  ros::Subscriber scan_sub_, odom_sub_, held_sub_;
   ros::ServiceServer map_srv_, save_srv_;
   ros::WallTimer diagnostics_timer_;
   diagnostic_updater::Updater updater_;
 
-  std::mutex odom_mutex_;  ///< odom_window_, odom_newest_ns_ (the spinner writes them, the worker reads them)
+  std::mutex odom_mutex_;  ///< odom_window_, odom_newest_ns_, held_ (the spinner writes them, the worker reads them)
   std::condition_variable odom_arrived_;
   MotionCovarianceWindow odom_window_;
   std::int64_t odom_newest_ns_ = 0;
+  std::deque<std::pair<std::int64_t, HeldMotion>> held_;  ///< recent held motions by stamp (odom_mutex_)
+  static constexpr std::size_t kHeldKept = 100;              ///< 10 s of scans at 10 Hz
 
   std::mutex load_mutex_;  ///< load_
   SlamLoadMonitor load_;

@@ -9,6 +9,7 @@
 
 #include <memory>
 
+#include "laser_dpslam/OdometryHold.h"
 #include "laser_dpslam/common/run_statistics.h"
 #include "laser_dpslam/odometry/laser_odometry.h"
 #include "laser_dpslam/odometry/odometry_parameters.h"
@@ -26,6 +27,7 @@ class LaserOdometryNode {
     readParameters(pnh);
     odometry_ = std::make_unique<LaserOdometry>(odom_config_);
     odom_pub_ = nh.advertise<nav_msgs::Odometry>(names::kOdomTopic, 20);
+    held_pub_ = nh.advertise<laser_dpslam::OdometryHold>(names::kOdometryHoldTopic, 20);
     scan_sub_ = nh.subscribe(names::kScanTopic, 20, &LaserOdometryNode::onScan, this);
     if (use_wheel_odometry_) {
       wheel_sub_ = nh.subscribe(names::kWheelOdomTopic, 100, &LaserOdometryNode::onWheelOdometry, this);
@@ -146,6 +148,16 @@ class LaserOdometryNode {
     }
     setPlanarCovariance(u.pose_covariance, &odom.pose.covariance);
     setPlanarCovariance(u.delta_covariance / (dt * dt), &odom.twist.covariance);
+    if (u.held_speed_sigma > 0.0) {
+      // Before the odom message: dpslam_node reads it once that message (and the TF) is in.
+      laser_dpslam::OdometryHold held;
+      held.header.stamp = scan.header.stamp;
+      held.header.frame_id = base_frame_;
+      held.direction.x = u.held_direction.x();
+      held.direction.y = u.held_direction.y();
+      held.speed_sigma = u.held_speed_sigma;
+      held_pub_.publish(held);
+    }
     odom_pub_.publish(odom);
 
     if (publish_tf_) {
@@ -171,6 +183,7 @@ class LaserOdometryNode {
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::Publisher odom_pub_;
+  ros::Publisher held_pub_;
   ros::Subscriber scan_sub_;
   ros::Subscriber wheel_sub_;
   std::size_t wheel_messages_ = 0;

@@ -286,6 +286,7 @@ class OfflineRun {
   Eigen::Matrix3d slam_delta_cov_ = Eigen::Matrix3d::Zero();  // its covariance, composed the same way
   Eigen::Matrix3d odom_last_covariance_ = Eigen::Matrix3d::Zero();  // the odometry's pose covariance at the last scan
   bool slam_has_last_ = false;
+  double slam_last_stamp_ = 0.0;
   std::vector<double> slam_ms_;
   DpSlamUpdate last_slam_;
   std::size_t max_tree_nodes_ = 0;
@@ -519,7 +520,14 @@ void OfflineRun::feedSlam(const LaserScan& scan, const PreprocessedScan& pre, co
   if (!slam_ || !have_motion) return;
   const Pose2D delta = slam_has_last_ && !u.reset ? between(slam_last_odom_, motion_pose) : Pose2D();
   const auto s0 = std::chrono::steady_clock::now();
-  last_slam_ = slam_->process(scan.stamp, pre, mount_, delta, slam_delta_cov_);
+  HeldMotion held;
+  if (slam_has_last_ && !u.reset && motion_.empty()) {
+    held.direction = u.held_direction;
+    held.speed_sigma = u.held_speed_sigma;
+    held.dt = scan.stamp - slam_last_stamp_;
+  }
+  last_slam_ = slam_->process(scan.stamp, pre, mount_, delta, slam_delta_cov_, held);
+  slam_last_stamp_ = scan.stamp;
   // Wall time: the SLAM scores particles on several threads.
   slam_ms_.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count());
   if (!last_slam_.ok) ++skipped_["slam_" + last_slam_.skip_reason];

@@ -566,8 +566,14 @@ TEST(LaserOdometry, HoldKeepsTheLaserOnlyEstimateMovingThroughABlankCorridor) {
   const std::vector<TimedPose> truth = samplePath({{3.0, 1.25}, {47.0, 1.25}}, 10.0, PathConfig());
   for (std::uint64_t seed = 1; seed <= 2; ++seed) {
     double worst = 0.0, sigma = 0.0;
-    int held = 0, held_uncovered = 0, uncovered = 0;
+    int held = 0, held_uncovered = 0, uncovered = 0, held_for_slam = 0, held_elsewhere = 0;
     runWithWheels(blankCorridor(), truth, 0.0, seed, [&](const TimedPose& tp, const OdometryUpdate& u) {
+      // The blank stretch's held speed goes to the SLAM (held_direction along the corridor), nothing else.
+      if (u.velocity_held && u.velocity_held_blank) {
+        held_for_slam += u.held_speed_sigma > 0.0 && std::abs(u.held_direction.x()) > 0.99 ? 1 : 0;
+      } else {
+        held_elsewhere += u.held_speed_sigma > 0.0 ? 1 : 0;
+      }
       const double error = u.pose.x - (tp.pose.x - truth.front().pose.x);
       worst = std::max(worst, std::abs(error));
       sigma = std::sqrt(u.pose_covariance(0, 0));
@@ -580,6 +586,8 @@ TEST(LaserOdometry, HoldKeepsTheLaserOnlyEstimateMovingThroughABlankCorridor) {
     EXPECT_GT(held, static_cast<int>(truth.size()) / 2) << "seed " << seed;
     EXPECT_EQ(held_uncovered, 0) << "seed " << seed;
     EXPECT_LE(uncovered, 2) << "seed " << seed;
+    EXPECT_GT(held_for_slam, static_cast<int>(truth.size()) / 2) << "seed " << seed;
+    EXPECT_EQ(held_elsewhere, 0) << "seed " << seed;
     RecordProperty("seed" + std::to_string(seed) + "_worst_mm", static_cast<int>(1000.0 * worst));
     RecordProperty("seed" + std::to_string(seed) + "_sigma_end_mm", static_cast<int>(1000.0 * sigma));
     RecordProperty("seed" + std::to_string(seed) + "_uncovered_scans", uncovered);

@@ -622,3 +622,55 @@ TEST(DpSlam, EitherTravelThresholdAloneWorks) {
   EXPECT_TRUE(travelThresholdReached(Pose2D(0.3, 0.0, 0.0), 0.2, 0.3));
   EXPECT_TRUE(travelThresholdReached(Pose2D(0.0, 0.0, 0.35), 0.2, 0.3));
 }
+
+// HeldMotion: along a blank corridor (two walls, nothing facing along it within the laser's range) the
+// odometry's motion is a held speed, whose error is the same at every scan. Each particle keeps one speed
+// error through the hold, so the particles' spread along the corridor grows with the time held (a
+// constant-velocity error); the match's variance along it, sampled at every scan, made it a random walk
+// growing with the root of the time. Across the corridor nothing changes. No resampling, one candidate per
+// particle and a negligible per-scan floor, so that the positions show the proposal alone.
+TEST(DpSlam, HeldSpeedErrorsGrowTheSpreadWithTheTimeHeld) {
+  const FloorPlan corridor = test::planFromBoxes(40.0, 2.4, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.3, 40.0, 2.4}});
+  DpSlamConfig config;
+  config.resample_threshold = 0.0;
+  config.oversampling = 1;
+  config.explore_noise_scale = 1.0;
+  config.proposal.min_sigma_xy = 0.001;
+  config.proposal.min_sigma_theta = 0.0005;
+  config.map_align_to_walls = false;
+  config.threads = 1;
+  const double dt = 0.1, speed = 0.3, speed_sigma = 0.01;
+  Eigen::Matrix3d match_cov = Eigen::Vector3d(0.02 * 0.02, 0.002 * 0.002, 0.001 * 0.001).asDiagonal();
+  // Spread (standard deviation over the particles) along and across the corridor after each scan.
+  auto spreads = [&](bool held_speed) {
+    DpSlam slam(config);
+    ScanSimulator sim(corridor, ScanSimulatorConfig(), 5);
+    std::vector<Eigen::Vector2d> out;
+    for (int k = 0; k <= 80; ++k) {
+      const double stamp = 100.0 + k * dt;
+      const PreprocessedScan scan = preprocessScan(sim.simulate(Pose2D(15.0 + speed * k * dt, 1.2, 0.0), stamp),
+                                                   ScanPreprocessorConfig());
+      HeldMotion held;
+      if (held_speed && k > 0) {
+        held.direction = Eigen::Vector2d(1.0, 0.0);
+        held.speed_sigma = speed_sigma;
+        held.dt = dt;
+      }
+      slam.process(stamp, scan, LaserMount(), Pose2D(k > 0 ? speed * dt : 0.0, 0.0, 0.0), match_cov, held);
+      const std::vector<Pose2D> poses = slam.particlePoses();
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero(), var = Eigen::Vector2d::Zero();
+      for (const Pose2D& p : poses) mean += Eigen::Vector2d(p.x, p.y) / poses.size();
+      for (const Pose2D& p : poses) var += (Eigen::Vector2d(p.x, p.y) - mean).cwiseAbs2() / poses.size();
+      out.push_back(var.cwiseSqrt());
+    }
+    return out;
+  };
+  const std::vector<Eigen::Vector2d> held = spreads(true), sampled = spreads(false);
+  std::printf("[ DpSlam   ] along-corridor spread after 2 / 8 s: held %.3f / %.3f m, sampled %.3f / %.3f m\n",
+              held[20].x(), held[80].x(), sampled[20].x(), sampled[80].x());
+  EXPECT_GT(held[80].x() / held[20].x(), 3.0);  // linear in time: 4
+  EXPECT_LT(sampled[80].x() / sampled[20].x(), 2.6);  // a random walk: 2
+  EXPECT_NEAR(held[80].x(), speed_sigma * 8.0, 0.5 * speed_sigma * 8.0);
+  EXPECT_LT(held[80].x(), 0.6 * sampled[80].x());  // no scan-by-scan jitter along the corridor
+  EXPECT_NEAR(held[80].y(), sampled[80].y(), 0.5 * sampled[80].y());
+}

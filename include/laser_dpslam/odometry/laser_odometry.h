@@ -110,6 +110,12 @@ struct OdometryUpdate {
   /// grows with the time held.
   bool velocity_held = false;
   bool velocity_held_blank = false;  ///< no surface in the scan faces along the corridor: the match kept the prior along it
+  /// A held velocity in a blank stretch (velocity_held and velocity_held_blank, laser only): the held
+  /// direction (unit, previous base frame, as delta) and the held speed's σ (m/s). The delta's error along it
+  /// is that speed's error times dt, the same at every scan of the stretch: a bias, not noise (DpSlam's
+  /// HeldMotion). Zero otherwise.
+  Eigen::Vector2d held_direction = Eigen::Vector2d::Zero();
+  double held_speed_sigma = 0.0;
   bool wheel_prior = false;           ///< the motion prior was the wheel odometry's (addWheelOdometry)
   bool new_keyframe = false;
   int points_used = 0;

@@ -7,6 +7,7 @@ namespace names {
 // Topics (relative: remap them in launch files).
 constexpr const char* kScanTopic = "scan";
 constexpr const char* kOdomTopic = "odom";
+constexpr const char* kOdometryHoldTopic = "odom_held";  ///< laser_odometry_node → dpslam_node (msg/OdometryHold.msg)
 constexpr const char* kWheelOdomTopic = "wheel_odom";  ///< the wheels' odometry, laser_odometry_node's input
 constexpr const char* kMapTopic = "map";
 constexpr const char* kMapMetadataTopic = "map_metadata";

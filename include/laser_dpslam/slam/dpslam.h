@@ -130,6 +130,19 @@ bool travelThresholdReached(const Pose2D& motion, double distance, double angle)
 /// the coarser levels lie more than a cell apart. Every cell is then crossed by some beam, as with all beams.
 double freeSpaceWriteFrom(long beam, int step, double increment, double resolution);
 
+/// The part of a scan's motion that the odometry held rather than measured: along `direction` (unit, in the
+/// previous base frame, as the delta) nothing in the scan faces the motion (a blank stretch of corridor), and
+/// the motion is a held speed times dt. Its error is that speed's error, the same at every scan of the hold
+/// (a bias, not noise): each particle draws one speed error when a hold starts and keeps it to the hold's
+/// end, so that its path runs straight along the corridor at its own speed instead of random-walking scan by
+/// scan where no scan can tell the steps apart (the particle-filter form of a constant velocity error).
+struct HeldMotion {
+  Eigen::Vector2d direction = Eigen::Vector2d::Zero();
+  double speed_sigma = 0.0;  ///< m/s, σ of the held speed
+  double dt = 0.0;           ///< s, the time the delta spans
+  bool active() const { return speed_sigma > 0.0 && dt > 0.0 && direction.squaredNorm() > 0.25; }
+};
+
 class DpSlam {
  public:
   explicit DpSlam(const DpSlamConfig& config = DpSlamConfig());
@@ -140,8 +153,9 @@ class DpSlam {
   /// One scan. `delta`/`delta_cov`: the laser odometry's motion since the previous call (in the previous
   /// base frame) and its covariance; ignored on the first scan, which defines the map frame (= the base
   /// frame at that scan, turned to its walls with map_align_to_walls). Skipped scans still move the particles by `delta`.
+  /// `held`: the delta's held component, if any (see HeldMotion).
   DpSlamUpdate process(double stamp, const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& delta,
-                       const Eigen::Matrix3d& delta_cov);
+                       const Eigen::Matrix3d& delta_cov, const HeldMotion& held = HeldMotion());
   void reset();
 
   bool initialized() const { return initialized_; }
@@ -201,6 +215,9 @@ class DpSlam {
   /// Steps 1-3 of filterStep: every particle's new pose into chosen, its log-likelihood there into ll.
   void propose(const Pose2D& delta, const Eigen::Matrix3d& cov, std::vector<Pose2D>& chosen,
                std::vector<double>& ll);
+  /// Starts, keeps or ends the particles' held speed errors for this update (HeldMotion); returns `cov`
+  /// without its variance along the held direction while holding.
+  Eigen::Matrix3d startHeldMotion(const Eigen::Matrix3d& cov);
   /// Sampled candidates, the best of `oversampling` per particle by the cheap score, then scored.
   void proposeSampled(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
                       std::vector<double>& ll);
@@ -235,6 +252,10 @@ class DpSlam {
   std::vector<StampedPose> motion_path_;  ///< motion_ at every pose of the particles' paths
   Eigen::Matrix3d pending_cov_ = Eigen::Matrix3d::Zero();
   int pending_scans_ = 0;  ///< scans whose motion pending_ composes (the proposal's noise floor is per scan)
+  HeldMotion pending_held_;     ///< the held part of pending_ (direction in pending_'s start frame, dt summed)
+  bool holding_ = false;        ///< the last filter update was inside a hold
+  double held_scale_ = 1.0;     ///< the proposal scale the speed errors were drawn at (explore_noise_scale or 1)
+  std::vector<double> held_speed_error_;  ///< per particle, m/s along the hold's direction (0 outside holds)
   Pose2D since_map_update_;     ///< filter motion since the last map update
   bool force_map_update_ = false;
 

@@ -343,6 +343,10 @@ void LaserOdometry::heldCovariance(const Pose2D& previous, double stamp, double 
     held_since_ = stamp - dt;
     held_start_variance_ = along;
   }
+  if (u.velocity_held_blank) {
+    u.held_direction = weak;
+    u.held_speed_sigma = sigma_v;
+  }
   const double grown = held_start_variance_ + std::pow(sigma_v * (stamp - held_since_), 2);
   if (grown > along) pose_covariance_.topLeftCorner<2, 2>() += (grown - along) * w * w.transpose();
 }

@@ -102,6 +102,9 @@ void DpSlam::reset() {
   pending_ = Pose2D();
   pending_cov_.setZero();
   pending_scans_ = 0;
+  pending_held_ = HeldMotion();
+  holding_ = false;
+  held_speed_error_.clear();
   motion_ = Pose2D();
   motion_path_.clear();
   since_map_update_ = Pose2D();
@@ -255,7 +258,7 @@ void DpSlam::record(double stamp) {
 }
 
 DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& delta,
-                             const Eigen::Matrix3d& delta_cov) {
+                             const Eigen::Matrix3d& delta_cov, const HeldMotion& held) {
   DpSlamUpdate u;
   u.stamp = stamp;
   if (!scan.ok()) {
@@ -289,6 +292,7 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
     applyWrites({0}, {root});
     leaves_ = tree_.advance({root}, std::vector<int>(P, 0), ++generation_, map_);
     poses_.assign(P, first);
+    held_speed_error_.assign(P, 0.0);
     best_ = 0;
     last_neff_ = P;
     initialized_ = true;
@@ -298,6 +302,14 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
     return u;
   }
 
+  if (held.active()) {
+    // Expressed in the frame pending_ starts from; the first held scan's direction stands for the rest.
+    if (!pending_held_.active()) {
+      pending_held_.direction = Pose2D(0.0, 0.0, pending_.theta).rotation() * held.direction.normalized();
+      pending_held_.speed_sigma = held.speed_sigma;
+    }
+    pending_held_.dt += held.dt;
+  }
   composeMotion(pending_, pending_cov_, delta, delta_cov);
   ++pending_scans_;
   motion_ = motion_ * delta;
@@ -343,6 +355,7 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
   pending_ = Pose2D();
   pending_cov_.setZero();
   pending_scans_ = 0;
+  pending_held_ = HeldMotion();
   record(stamp);
   u.filter_updated = true;
   u.resampled = resample;
@@ -351,14 +364,39 @@ void DpSlam::filterStep(double stamp, const Pose2D& delta, const Eigen::Matrix3d
 void DpSlam::propose(const Pose2D& delta, const Eigen::Matrix3d& cov, std::vector<Pose2D>& chosen,
                      std::vector<double>& ll) {
   // 1. Proposal: each particle moves by the delta plus noise, in its own frame. Draws in a fixed order.
-  Eigen::Matrix3d L = proposalFactor(delta, cov, config_.proposal, std::max(1, pending_scans_));
-  // Exploring, the noise mostly random-walks the particles (their fresh maps move with them); back on old
-  // ground it is what lets the filter find the older map's alignment (doc/benchmarks.md).
   const Pose2D ahead = poses_[best_] * delta;
   last_revisit_ = revisit_.update(Eigen::Vector2d(ahead.x, ahead.y), std::hypot(delta.x, delta.y));
+  Eigen::Matrix3d L = proposalFactor(delta, startHeldMotion(cov), config_.proposal, std::max(1, pending_scans_));
+  // Exploring, the noise mostly random-walks the particles (their fresh maps move with them); back on old
+  // ground it is what lets the filter find the older map's alignment (doc/benchmarks.md).
   if (!last_revisit_) L *= config_.explore_noise_scale;
   for (auto& c : caches_) c.begin(tree_, leaves_);
   proposeSampled(delta, L, chosen, ll);
+}
+
+Eigen::Matrix3d DpSlam::startHeldMotion(const Eigen::Matrix3d& cov) {
+  const HeldMotion& h = pending_held_;
+  const int P = config_.particles;
+  if (!h.active()) {
+    holding_ = false;
+    held_speed_error_.assign(P, 0.0);
+    return cov;
+  }
+  // Exploring, a speed error moves the particle's fresh map with it and nothing can tell it apart: the
+  // errors are drawn as small as the proposal's noise there (explore_noise_scale), and widened when the hold
+  // reaches old ground, where the older map can choose between them.
+  const double scale = last_revisit_ ? 1.0 : config_.explore_noise_scale;
+  if (!holding_ || scale > held_scale_) {
+    const double from = holding_ ? held_scale_ : 0.0;
+    const double sigma = h.speed_sigma * std::sqrt(scale * scale - from * from);
+    for (int i = 0; i < P; ++i) held_speed_error_[i] = (holding_ ? held_speed_error_[i] : 0.0) + sigma * rng_.normal();
+    holding_ = true;
+    held_scale_ = scale;
+  }
+  // Along the held direction the match measured nothing: its variance there is replaced by the speed errors.
+  Eigen::Matrix3d A = Eigen::Matrix3d::Identity();
+  A.topLeftCorner<2, 2>() -= h.direction * h.direction.transpose();
+  return A * cov * A.transpose();
 }
 
 void DpSlam::proposeSampled(const Pose2D& delta, const Eigen::Matrix3d& L, std::vector<Pose2D>& chosen,
@@ -367,7 +405,13 @@ void DpSlam::proposeSampled(const Pose2D& delta, const Eigen::Matrix3d& L, std::
   const int K = config_.oversampling;
   std::vector<Pose2D> candidates(static_cast<std::size_t>(P) * K);
   for (int i = 0; i < P; ++i) {
-    for (int k = 0; k < K; ++k) candidates[static_cast<std::size_t>(i) * K + k] = poses_[i] * sampleMotion(delta, L, rng_);
+    Pose2D d = delta;
+    if (holding_) {
+      const double along = held_speed_error_[i] * pending_held_.dt;
+      d.x += along * pending_held_.direction.x();
+      d.y += along * pending_held_.direction.y();
+    }
+    for (int k = 0; k < K; ++k) candidates[static_cast<std::size_t>(i) * K + k] = poses_[i] * sampleMotion(d, L, rng_);
   }
   // 2. Over-sampling: keep each particle's best candidate by the cheap endpoint score.
   if (K > 1) {
@@ -422,10 +466,13 @@ void DpSlam::adoptSurvivors(const std::vector<int>& parents, const std::vector<P
   std::vector<double> new_logw(P);
   const double max_logw = logw_[best_parent];
   best_ = 0;
+  std::vector<double> new_error(P);
   for (int j = 0; j < P; ++j) {
     poses_[j] = chosen[parents[j]];
     new_logw[j] = resampled ? 0.0 : logw_[parents[j]] - max_logw;
+    new_error[j] = held_speed_error_[parents[j]];
   }
+  held_speed_error_.swap(new_error);
   for (int j = 0; j < P; ++j) {
     if (parents[j] == best_parent) {
       best_ = j;
