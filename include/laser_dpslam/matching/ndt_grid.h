@@ -49,6 +49,22 @@ struct NdtScore {
   int matched = 0;  ///< points with at least one cell within 3σ (Mahalanobis² < 9)
 };
 
+/// The score's terms at one pose: h, and per scan point the Gaussians within reach with what their
+/// derivatives need. The Newton polish rejects about a third of the poses it scores (a step that overshoots,
+/// or crosses cell borders where h jumps), so it takes h first and the derivatives only where it moves.
+struct NdtTerms {
+  struct Term {
+    const NdtCell* cell;
+    double e;         ///< weight · exp(−½ qᵀΣ⁻¹q)
+    double iqx, iqy;  ///< Σ⁻¹q
+    int point;        ///< index into the scan's points
+  };
+  Pose2D pose;
+  double h = 0.0;
+  int matched = 0;
+  std::vector<Term> terms;  ///< in point order, then layer order
+};
+
 class NdtGrid {
  public:
   NdtGrid() = default;
@@ -67,6 +83,11 @@ class NdtGrid {
   /// h at `pose` for `points` given in the moving frame; gradient and Hessian w.r.t. (x, y, θ) when
   /// `derivatives` is set (Jacobian at the scan-frame point, doc/algorithms.md §2).
   NdtScore score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points, bool derivatives) const;
+
+  /// The two halves of score(): h at `pose` with the terms kept (their storage is reused), then the
+  /// gradient and Hessian from them. Together they give exactly what score() gives.
+  void evaluate(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points, NdtTerms* terms) const;
+  NdtScore derivatives(const std::vector<Eigen::Vector2d>& points, const NdtTerms& terms) const;
 
   /// Σ over the four grids of exp(−½ qᵀΣ⁻¹q) for one point in the grid's frame (0 … 4).
   double density(const Eigen::Vector2d& p) const;

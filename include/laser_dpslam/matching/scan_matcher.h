@@ -130,6 +130,8 @@ class ScanMatcher {
   Eigen::Matrix3d boundedByWindow(const Eigen::Matrix3d& cov) const;
 
  private:
+  /// The Newton step at s (the Hessian made positive definite), within `basis`'s span when given.
+  static Eigen::Vector3d newtonStep(const NdtScore& s, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis);
   /// What the steps of one match() share.
   struct MatchInput {
     const std::vector<Eigen::Vector2d>& search_points;

@@ -125,19 +125,27 @@ double NdtGrid::density(const Eigen::Vector2d& p) const {
 
 NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points,
                         bool derivatives) const {
+  NdtTerms terms;
+  evaluate(pose, points, &terms);
+  if (derivatives) return this->derivatives(points, terms);
   NdtScore out;
-  if (valid_cells_ == 0) return out;
+  out.h = terms.h;
+  out.matched = terms.matched;
+  return out;
+}
+
+void NdtGrid::evaluate(const Pose2D& pose, const std::vector<Eigen::Vector2d>& points, NdtTerms* out) const {
+  out->pose = pose;
+  out->h = 0.0;
+  out->matched = 0;
+  out->terms.clear();
+  if (valid_cells_ == 0) return;
   const double inv = 1.0 / config_.cell_size;
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
-  // Accumulated in scalars (this loop is the matcher's hot spot): gradient g0..g2 and the upper
-  // triangle of the symmetric Hessian.
-  double h = 0, g0 = 0, g1 = 0, g2 = 0, H00 = 0, H01 = 0, H02 = 0, H11 = 0, H12 = 0, H22 = 0;
-  for (const auto& a : points) {
-    const double xx = c * a.x() - s * a.y() + pose.x, xy = s * a.x() + c * a.y() + pose.y;
-    // Jacobian column for θ and the only non-zero second derivative (∂²x'/∂θ²), at the scan-frame point.
-    const double jx = -s * a.x() - c * a.y(), jy = c * a.x() - s * a.y();
-    const double hx = -c * a.x() + s * a.y(), hy = -s * a.x() - c * a.y();
-    const Eigen::Vector2d x(xx, xy);
+  double h = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d& a = points[i];
+    const Eigen::Vector2d x(c * a.x() - s * a.y() + pose.x, s * a.x() + c * a.y() + pose.y);
     // The point's terms are computed for all four layers first and summed after, in layer order: the four
     // exp() are then independent of the sums, and the CPU overlaps them. (Skipping a far cell inside this
     // first loop, rather than flagging it, put the branch back before the exp() and lost the gain.)
@@ -151,7 +159,7 @@ NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& 
     bool matched = false;
     for (int k = 0; k < n; ++k) {
       const NdtCell* cell = cells[k];
-      const double qx = xx - cell->mean.x(), qy = xy - cell->mean.y();
+      const double qx = x.x() - cell->mean.x(), qy = x.y() - cell->mean.y();
       const double a00 = cell->information(0, 0), a01 = cell->information(0, 1), a11 = cell->information(1, 1);
       iq[k][0] = a00 * qx + a01 * qy;  // Σ⁻¹q
       iq[k][1] = a01 * qx + a11 * qy;
@@ -163,28 +171,51 @@ NdtScore NdtGrid::score(const Pose2D& pose, const std::vector<Eigen::Vector2d>& 
     }
     for (int k = 0; k < n; ++k) {
       if (!near[k]) continue;
-      const NdtCell* cell = cells[k];
-      const double a00 = cell->information(0, 0), a01 = cell->information(0, 1), a11 = cell->information(1, 1);
-      const double iqx = iq[k][0], iqy = iq[k][1];
       h -= e[k];
-      if (!derivatives) continue;
-      // g_k = e·qᵀΣ⁻¹J_k with J = [e_x, e_y, j_θ].
-      const double qj = iqx * jx + iqy * jy;
-      g0 += e[k] * iqx;
-      g1 += e[k] * iqy;
-      g2 += e[k] * qj;
-      // H_kl = e·[−(qᵀΣ⁻¹J_k)(qᵀΣ⁻¹J_l) + qᵀΣ⁻¹∂²x'/∂p_k∂p_l + J_lᵀΣ⁻¹J_k]
-      const double ijx = a00 * jx + a01 * jy, ijy = a01 * jx + a11 * jy;  // Σ⁻¹j_θ
-      H00 += e[k] * (a00 - iqx * iqx);
-      H01 += e[k] * (a01 - iqx * iqy);
-      H02 += e[k] * (ijx - iqx * qj);
-      H11 += e[k] * (a11 - iqy * iqy);
-      H12 += e[k] * (ijy - iqy * qj);
-      H22 += e[k] * (jx * ijx + jy * ijy - qj * qj + iqx * hx + iqy * hy);
+      out->terms.push_back({cells[k], e[k], iq[k][0], iq[k][1], static_cast<int>(i)});
     }
-    if (matched) ++out.matched;
+    if (matched) ++out->matched;
   }
-  out.h = h;
+  out->h = h;
+}
+
+NdtScore NdtGrid::derivatives(const std::vector<Eigen::Vector2d>& points, const NdtTerms& terms) const {
+  NdtScore out;
+  out.h = terms.h;
+  out.matched = terms.matched;
+  const double c = std::cos(terms.pose.theta), s = std::sin(terms.pose.theta);
+  // Per point, the gradient of its density in the plane, −v = −Σ_k e_k Σ_k⁻¹q_k, and its negated Hessian
+  // M = Σ_k e_k (Σ_k⁻¹ − Σ_k⁻¹q_k q_kᵀΣ_k⁻¹); the pose's derivatives follow through J = [e_x, e_y, j_θ]:
+  // g = Jᵀv, H = JᵀMJ + (v·∂²x'/∂θ²) in the θθ entry. Accumulated in scalars (the upper triangle of H).
+  double g0 = 0, g1 = 0, g2 = 0, H00 = 0, H01 = 0, H02 = 0, H11 = 0, H12 = 0, H22 = 0;
+  const std::vector<NdtTerms::Term>& t = terms.terms;
+  for (std::size_t i = 0; i < t.size();) {
+    const int point = t[i].point;
+    double vx = 0, vy = 0, m00 = 0, m01 = 0, m11 = 0;
+    for (; i < t.size() && t[i].point == point; ++i) {
+      const Eigen::Matrix2d& A = t[i].cell->information;
+      const double e = t[i].e, ex = e * t[i].iqx, ey = e * t[i].iqy;
+      vx += ex;
+      vy += ey;
+      m00 += e * A(0, 0) - ex * t[i].iqx;
+      m01 += e * A(0, 1) - ex * t[i].iqy;
+      m11 += e * A(1, 1) - ey * t[i].iqy;
+    }
+    // Jacobian column for θ and the only non-zero second derivative (∂²x'/∂θ²), at the scan-frame point.
+    const Eigen::Vector2d& a = points[point];
+    const double jx = -s * a.x() - c * a.y(), jy = c * a.x() - s * a.y();
+    const double hx = -c * a.x() + s * a.y(), hy = -s * a.x() - c * a.y();
+    const double mjx = m00 * jx + m01 * jy, mjy = m01 * jx + m11 * jy;  // M j_θ
+    g0 += vx;
+    g1 += vy;
+    g2 += vx * jx + vy * jy;
+    H00 += m00;
+    H01 += m01;
+    H02 += mjx;
+    H11 += m11;
+    H12 += mjy;
+    H22 += jx * mjx + jy * mjy + vx * hx + vy * hy;
+  }
   out.gradient << g0, g1, g2;
   out.hessian << H00, H01, H02, H01, H11, H12, H02, H12, H22;
   return out;

@@ -27,68 +27,71 @@ void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points, const
 
 bool ScanMatcher::hasReference() const { return !grids_.empty() && !grids_.back().empty(); }
 
+Eigen::Vector3d ScanMatcher::newtonStep(const NdtScore& s, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis) {
+  // Newton with the Hessian made positive definite (doc/algorithms.md §2).
+  Eigen::Matrix3d H = s.hessian;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(H, Eigen::EigenvaluesOnly);
+  const double lmin = es.eigenvalues()(0);
+  if (lmin <= 0.0) H += (1.0 - 1.1 * lmin) * Eigen::Matrix3d::Identity();
+  if (!basis) return -H.ldlt().solve(s.gradient);
+  // Newton in the subspace: Δ = B (BᵀHB)⁻¹ Bᵀ(−g).
+  const Eigen::MatrixXd Hb = basis->transpose() * H * *basis;
+  return -*basis * Hb.ldlt().solve(basis->transpose() * s.gradient);
+}
+
 Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pose2D& start, std::size_t level,
                            int* iterations, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis,
                            const Pose2D* prior, double prior_sigma_xy, NdtScore* final_score) const {
   const NdtGrid& grid = grids_.at(level);
   // The motion prior as a quadratic term in h's units, see prior_sigma_xy.
   const double w = prior ? priorWeight(prior_sigma_xy) : 0.0;
-  // `raw` receives the score without the prior's term.
-  auto score = [&](const Pose2D& p, NdtScore* raw) {
-    NdtScore r = grid.score(p, points, true);
+  auto priorTerm = [&](const Pose2D& p) {
+    const Eigen::Vector2d d(p.x - prior->x, p.y - prior->y);
+    return 0.5 * w * d.squaredNorm();
+  };
+  // The score with its derivatives at the terms' pose; `raw` receives it without the prior's term.
+  auto score = [&](const NdtTerms& t, NdtScore* raw) {
+    NdtScore r = grid.derivatives(points, t);
     *raw = r;
     if (w > 0.0) {
-      const Eigen::Vector2d d(p.x - prior->x, p.y - prior->y);
-      r.h += 0.5 * w * d.squaredNorm();
-      r.gradient.head<2>() += w * d;
+      r.h += priorTerm(t.pose);
+      r.gradient.head<2>() += w * Eigen::Vector2d(t.pose.x - prior->x, t.pose.y - prior->y);
       r.hessian.topLeftCorner<2, 2>() += w * Eigen::Matrix2d::Identity();
     }
     return r;
   };
-  Pose2D pose = start;
+  NdtTerms terms, trial;
+  terms.terms.reserve(4 * points.size());
+  trial.terms.reserve(4 * points.size());
+  grid.evaluate(start, points, &terms);
   NdtScore raw;
-  NdtScore s = score(pose, &raw);
+  NdtScore s = score(terms, &raw);
   int it = 0;
   for (; it < config_.newton_iterations; ++it) {
-    // Newton with the Hessian made positive definite (doc/algorithms.md §2).
-    Eigen::Matrix3d H = s.hessian;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-    es.computeDirect(H, Eigen::EigenvaluesOnly);
-    const double lmin = es.eigenvalues()(0);
-    if (lmin <= 0.0) H += (1.0 - 1.1 * lmin) * Eigen::Matrix3d::Identity();
-    Eigen::Vector3d delta;
-    if (basis) {
-      // Newton in the subspace: Δ = B (BᵀHB)⁻¹ Bᵀ(−g).
-      const Eigen::MatrixXd Hb = basis->transpose() * H * *basis;
-      delta = -*basis * Hb.ldlt().solve(basis->transpose() * s.gradient);
-    } else {
-      delta = -H.ldlt().solve(s.gradient);
-    }
+    const Eigen::Vector3d delta = newtonStep(s, basis);
     if (!delta.allFinite()) break;
-    // Backtracking: a Newton step on a sum of Gaussians can overshoot.
-    double step = 1.0;
+    // Backtracking: a Newton step on a sum of Gaussians can overshoot (and h jumps where a point changes
+    // cell). A step below the tolerance is not scored: it would only confirm convergence.
+    auto converged = [&](double step) {
+      return (step * delta).head<2>().norm() < config_.newton_tolerance &&
+             std::abs(step * delta.z()) < config_.newton_tolerance;
+    };
     bool improved = false;
-    for (int k = 0; k < 6; ++k) {
-      const Pose2D cand(pose.x + step * delta.x(), pose.y + step * delta.y(),
-                        normalizeAngle(pose.theta + step * delta.z()));
-      NdtScore craw;
-      NdtScore cs = score(cand, &craw);
-      if (cs.h <= s.h) {
-        pose = cand;
-        s = cs;
-        raw = craw;
+    double step = 1.0;
+    for (int k = 0; k < 6 && !improved && !converged(step); ++k, step *= 0.5) {
+      grid.evaluate(Pose2D(terms.pose.x + step * delta.x(), terms.pose.y + step * delta.y(),
+                           normalizeAngle(terms.pose.theta + step * delta.z())),
+                    points, &trial);
+      if (trial.h + (w > 0.0 ? priorTerm(trial.pose) : 0.0) <= s.h) {
+        std::swap(terms, trial);
+        s = score(terms, &raw);
         improved = true;
-        break;
       }
-      step *= 0.5;
     }
     if (!improved) break;
-    if ((step * delta).head<2>().norm() < config_.newton_tolerance &&
-        std::abs(step * delta.z()) < config_.newton_tolerance) {
-      ++it;
-      break;
-    }
   }
+  const Pose2D pose = terms.pose;
   if (iterations) *iterations += it;
   if (final_score) *final_score = raw;
   return pose;
