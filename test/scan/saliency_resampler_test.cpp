@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -212,6 +213,40 @@ TEST(SaliencyResampler, KeepsCoverageOfTheWholeRoom) {
   double worst = 0.0;
   for (const Vector2d& q : p.points) worst = std::max(worst, nearestKept(p, idx, q));
   EXPECT_LT(worst, 0.5);
+}
+
+// With no share for the score, the picks are plain farthest-point sampling from the first eligible point:
+// each next pick the point farthest from all picks so far, the lower index on a tie.
+TEST(SaliencyResampler, CoverageIsFarthestPointSampling) {
+  PreprocessedScan p = roomScan(0.005);
+  // Repeated points make ties.
+  for (std::size_t i = 0; i < p.points.size(); i += 7) p.points[i] = p.points[i / 2];
+  SaliencyConfig cfg;
+  cfg.salient_fraction = 0.0;
+  const SaliencyFeatures f = computeSaliency(p, cfg);
+  const std::size_t n = p.points.size();
+  for (std::size_t budget : {std::size_t{1}, std::size_t{17}, std::size_t{100}, std::size_t{300}}) {
+    std::vector<int> expected;
+    std::vector<double> d2(n, std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < n; ++i)
+      if (f.edge[i] == EdgeType::kShadow) d2[i] = -1.0;
+    int next = -1;
+    for (std::size_t i = 0; i < n && next < 0; ++i)
+      if (d2[i] >= 0.0) next = static_cast<int>(i);
+    while (expected.size() < budget && next >= 0) {
+      expected.push_back(next);
+      d2[next] = -1.0;
+      int best = -1;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (d2[i] < 0.0) continue;
+        d2[i] = std::min(d2[i], (p.points[i] - p.points[next]).squaredNorm());
+        if (best < 0 || d2[i] > d2[best]) best = static_cast<int>(i);
+      }
+      next = best;
+    }
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(saliencyResample(p, budget, cfg, 5), expected) << "budget " << budget;
+  }
 }
 
 TEST(SaliencyResampler, BudgetSortedUniqueForEveryBudgetAndMode) {
