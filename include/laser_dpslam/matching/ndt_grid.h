@@ -50,10 +50,13 @@ struct NdtScore {
 };
 
 /// The score's terms at one pose: h, and per scan point the Gaussians within reach with what their
-/// derivatives need. The Newton polish rejects about a third of the poses it scores (a step that overshoots,
+/// derivatives need. The Newton polish rejects two in five of the steps it tries (a step that overshoots,
 /// or crosses cell borders where h jumps), so it takes h first and the derivatives only where it moves.
 struct NdtTerms {
   struct Term {
+    // Built in place (emplace_back): a Term assembled on the stack and copied stalled the loop on store
+    // forwarding (the copy's 16-byte loads span the fields' separate stores).
+    Term(const NdtCell* c, double e_, double x, double y, int p) : cell(c), e(e_), iqx(x), iqy(y), point(p) {}
     const NdtCell* cell;
     double e;         ///< weight · exp(−½ qᵀΣ⁻¹q)
     double iqx, iqy;  ///< Σ⁻¹q

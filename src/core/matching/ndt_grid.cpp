@@ -172,7 +172,7 @@ void NdtGrid::evaluate(const Pose2D& pose, const std::vector<Eigen::Vector2d>& p
     for (int k = 0; k < n; ++k) {
       if (!near[k]) continue;
       h -= e[k];
-      out->terms.push_back({cells[k], e[k], iq[k][0], iq[k][1], static_cast<int>(i)});
+      out->terms.emplace_back(cells[k], e[k], iq[k][0], iq[k][1], static_cast<int>(i));
     }
     if (matched) ++out->matched;
   }
@@ -184,8 +184,8 @@ NdtScore NdtGrid::derivatives(const std::vector<Eigen::Vector2d>& points, const 
   out.h = terms.h;
   out.matched = terms.matched;
   const double c = std::cos(terms.pose.theta), s = std::sin(terms.pose.theta);
-  // Per point, the gradient of its density in the plane, −v = −Σ_k e_k Σ_k⁻¹q_k, and its negated Hessian
-  // M = Σ_k e_k (Σ_k⁻¹ − Σ_k⁻¹q_k q_kᵀΣ_k⁻¹); the pose's derivatives follow through J = [e_x, e_y, j_θ]:
+  // Per point, the gradient and Hessian of its term of h in the plane, v = Σ_k e_k Σ_k⁻¹q_k and
+  // M = Σ_k e_k (Σ_k⁻¹ − Σ_k⁻¹q_k q_kᵀΣ_k⁻¹); the pose's follow through J = [e_x, e_y, j_θ] (doc/algorithms.md §2):
   // g = Jᵀv, H = JᵀMJ + (v·∂²x'/∂θ²) in the θθ entry. Accumulated in scalars (the upper triangle of H).
   double g0 = 0, g1 = 0, g2 = 0, H00 = 0, H01 = 0, H02 = 0, H11 = 0, H12 = 0, H22 = 0;
   const std::vector<NdtTerms::Term>& t = terms.terms;
