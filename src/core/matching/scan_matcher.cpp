@@ -72,14 +72,10 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
     const Eigen::Vector3d delta = newtonStep(s, basis);
     if (!delta.allFinite()) break;
     // Backtracking: a Newton step on a sum of Gaussians can overshoot (and h jumps where a point changes
-    // cell). A step below the tolerance is not scored: it would only confirm convergence.
-    auto converged = [&](double step) {
-      return (step * delta).head<2>().norm() < config_.newton_tolerance &&
-             std::abs(step * delta.z()) < config_.newton_tolerance;
-    };
-    bool improved = false;
+    // cell). A trial is scored by h alone; the derivatives only for the step taken.
     double step = 1.0;
-    for (int k = 0; k < 6 && !improved && !converged(step); ++k, step *= 0.5) {
+    bool improved = false;
+    for (int k = 0; k < 6; ++k) {
       grid.evaluate(Pose2D(terms.pose.x + step * delta.x(), terms.pose.y + step * delta.y(),
                            normalizeAngle(terms.pose.theta + step * delta.z())),
                     points, &trial);
@@ -87,9 +83,16 @@ Pose2D ScanMatcher::polish(const std::vector<Eigen::Vector2d>& points, const Pos
         std::swap(terms, trial);
         s = score(terms, &raw);
         improved = true;
+        break;
       }
+      step *= 0.5;
     }
     if (!improved) break;
+    if ((step * delta).head<2>().norm() < config_.newton_tolerance &&
+        std::abs(step * delta.z()) < config_.newton_tolerance) {
+      ++it;
+      break;
+    }
   }
   const Pose2D pose = terms.pose;
   if (iterations) *iterations += it;
