@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -145,6 +146,103 @@ TEST(DpSlamMap, CachedLookupsEqualReferenceLookups) {
       }
     }
   }
+}
+
+// The free-cell bits (setRoot) only skip look-ups: two maps with the same history, one told the tree's root,
+// score and plan every beam for every particle the same, through writes, hits, saturation, pruning and
+// lineages merging into the root.
+TEST(DpSlamMap, FreeCellBitsChangeNoScoreAndNoWrite) {
+  struct Side {
+    AncestryTree tree;
+    DpSlamMap map{0.1, 4.0};
+    std::vector<int> leaves;
+  };
+  Side with, without;
+  for (Side* s : {&with, &without}) {
+    s->map.setFreeSaturation(0.8);  // above the prior (0.4 m): a cell is passed a few times before it saturates
+    const int root = s->tree.createRoot();
+    s->leaves = {root};
+  }
+  with.map.setRoot(with.leaves[0]);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  // Beams in a 2.4 m square room (so that scores are not all at the floor), from a particle's position:
+  // each particle's beams start a few centimetres apart, so each lineage knows cells the others do not.
+  auto roomBeam = [&](double ox, double oy, double a) {
+    MapBeam b;
+    b.ox = ox;
+    b.oy = oy;
+    b.dx = std::cos(a);
+    b.dy = std::sin(a);
+    const double tx = std::abs(b.dx) > 1e-9 ? ((b.dx > 0.0 ? 1.2 : -1.2) - ox) / b.dx : 1e9;
+    const double ty = std::abs(b.dy) > 1e-9 ? ((b.dy > 0.0 ? 1.2 : -1.2) - oy) / b.dy : 1e9;
+    b.range = std::min(tx, ty) + 0.02 * (u(rng) - 0.5);
+    b.no_return = u(rng) < 0.1;
+    return b;
+  };
+  const BeamModelConfig model;
+  const int P = 8;
+  std::size_t compared = 0;
+  for (int step = 1; step < 80; ++step) {
+    std::vector<int> parents(P);
+    const int spread = step % 5 == 0 ? 1 : (step % 3 == 0 ? P / 3 : P);  // now and then, one survivor
+    for (int j = 0; j < P; ++j) parents[j] = step == 1 ? 0 : static_cast<int>(rng() % spread);
+    const double cx = 0.6 * (u(rng) - 0.5), cy = 0.6 * (u(rng) - 0.5);
+    std::vector<std::vector<MapBeam>> beams(with.leaves.size());
+    for (auto& bs : beams) {
+      const double ox = cx + 0.1 * (u(rng) - 0.5), oy = cy + 0.1 * (u(rng) - 0.5);
+      // A scan: in angle order, so that a lineage passes a cell by one beam and stops in it by the next.
+      for (int n = 0; n < 120; ++n) bs.push_back(roomBeam(ox, oy, 2.0 * M_PI * (n + u(rng)) / 120.0));
+    }
+    std::vector<LookupCache> caches(2);
+    std::vector<std::vector<DpSlamMap::CellWrite>> plans[2];
+    int side = 0;
+    for (Side* s : {&with, &without}) {
+      LookupCache& cache = caches[side];
+      cache.begin(s->tree, s->leaves);
+      plans[side].resize(s->leaves.size());
+      for (std::size_t k = 0; k < s->leaves.size(); ++k) {
+        for (const MapBeam& b : beams[k]) s->map.planBeam(b, 20.0, static_cast<int>(k), cache, plans[side][k], step % 7 == 0);
+      }
+      ++side;
+    }
+    for (std::size_t k = 0; k < with.leaves.size(); ++k) {
+      ASSERT_EQ(plans[0][k].size(), plans[1][k].size()) << "step " << step;
+      for (std::size_t i = 0; i < plans[0][k].size(); ++i) {
+        const auto &a = plans[0][k][i], &b = plans[1][k][i];
+        ASSERT_TRUE(a.ix == b.ix && a.iy == b.iy && a.d == b.d && a.hit == b.hit) << "step " << step;
+      }
+      for (int n = 0; n < 20; ++n) {
+        const MapBeam b = roomBeam(cx + 0.1 * (u(rng) - 0.5), cy + 0.1 * (u(rng) - 0.5), 2.0 * M_PI * u(rng));
+        const int slot = static_cast<int>(k);
+        ASSERT_EQ(with.map.beamLogLikelihood(b, 20.0, slot, caches[0], model),
+                  without.map.beamLogLikelihood(b, 20.0, slot, caches[1], model)) << "step " << step;
+        ASSERT_EQ(with.map.beamEndpointLogLikelihood(b, 0.25, slot, caches[0], model),
+                  without.map.beamEndpointLogLikelihood(b, 0.25, slot, caches[1], model)) << "step " << step;
+        ++compared;
+      }
+    }
+    // Each surviving lineage writes its plan into the node it owns after the advance (as DpSlam does).
+    side = 0;
+    for (Side* s : {&with, &without}) {
+      std::vector<int> lineage;
+      const std::vector<int> old = s->leaves;
+      s->leaves = s->tree.advance(s->leaves, parents, step + 1, s->map, &lineage);
+      std::vector<int> who, nodes;
+      for (std::size_t i = 0; i < old.size(); ++i) {
+        if (std::find(parents.begin(), parents.end(), static_cast<int>(i)) == parents.end()) continue;
+        who.push_back(static_cast<int>(i));
+        nodes.push_back(lineage[i]);
+      }
+      LookupCache cache;
+      cache.begin(s->tree, nodes);
+      for (std::size_t k = 0; k < who.size(); ++k) s->map.applyWrites(plans[side][who[k]], static_cast<int>(k), nodes[k], cache);
+      ASSERT_EQ(s->map.check(), "") << "step " << step;
+      ++side;
+    }
+    ASSERT_EQ(with.map.entryCount(), without.map.entryCount()) << "step " << step;
+  }
+  EXPECT_GT(compared, 0u);
 }
 
 // Pruning and collapsing change who owns what, never what a surviving particle sees.
@@ -341,8 +439,8 @@ TEST(DpSlamMap, PlanBeamOnlyUnknownLeavesTheKnownCellsOut) {
   w.map.addBeam(OneLineage::alongX(0.05, 0.32), 20.0, 0, w.root, w.cache);  // cells 0-3 known, the return in cell 3
   MapBeam b = OneLineage::alongX(0.05, 0.72);  // now through cells 0-7, the return in cell 7
   std::vector<DpSlamMap::CellWrite> all, unknown;
-  w.map.planBeam(b, 20.0, 0, w.cache, 0.0, all);
-  w.map.planBeam(b, 20.0, 0, w.cache, 0.0, unknown, true);
+  w.map.planBeam(b, 20.0, 0, w.cache, all);
+  w.map.planBeam(b, 20.0, 0, w.cache, unknown, true);
   ASSERT_EQ(all.size(), 8u);
   ASSERT_EQ(unknown.size(), 4u);
   for (std::size_t k = 0; k < unknown.size(); ++k) {
@@ -354,7 +452,7 @@ TEST(DpSlamMap, PlanBeamOnlyUnknownLeavesTheKnownCellsOut) {
   // A row the root's entries are not visible to (a beam elsewhere) is all unknown.
   b.oy = 1.05;
   unknown.clear();
-  w.map.planBeam(b, 20.0, 0, w.cache, 0.0, unknown, true);
+  w.map.planBeam(b, 20.0, 0, w.cache, unknown, true);
   EXPECT_EQ(unknown.size(), 8u);
 }
 

@@ -41,7 +41,11 @@ inline void traceCells(double ox, double oy, double dx, double dy, double t_begi
   if (!(t_end > t_begin)) return;
   const double inv = 1.0 / resolution;
   const double px = (ox + dx * t_begin) * inv, py = (oy + dy * t_begin) * inv;
-  int ix = static_cast<int>(std::floor(px)), iy = static_cast<int>(std::floor(py));
+  // floor as truncation and a correction: the same integers as std::floor in fewer instructions (x86-64
+  // before SSE4.1 has no rounding instruction, and a trace is often only a few cells long).
+  int ix = static_cast<int>(px), iy = static_cast<int>(py);
+  ix -= px < ix;
+  iy -= py < iy;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const int sx = dx > 0.0 ? 1 : -1, sy = dy > 0.0 ? 1 : -1;
   const double tdx = dx != 0.0 ? resolution / std::abs(dx) : kInf;
@@ -174,6 +178,15 @@ class DpSlamMap : public AncestryHooks {
   /// difference (doc/benchmarks.md, start jitter). false = off.
   void setSurfaceOffsets(bool on) { surface_offsets_ = on; }
   bool surfaceOffsets() const { return surface_offsets_; }
+  /// Free-space saturation: a crossed cell whose visible statistics show no hit over at least `distance` m
+  /// is not rewritten (its density is 0 either way; this saves a copy per particle of every free cell).
+  /// 0 = always write. Set before the first write.
+  void setFreeSaturation(double distance);
+  /// The ancestry tree's root, whose entries every lineage sees. A cell holding a root entry and no entry
+  /// with a hit is free for every particle: the traces skip its look-up (a byte per cell, beside the tile,
+  /// instead of the cell's entries: most of a beam's path is such cells). -1 = none. Set before the first
+  /// write; clear() forgets it.
+  void setRoot(int node) { root_ = node; }
   /// MapEntry::offset: 0 = none, else k in 1..255 for (k − 128)/127 · 0.75 · resolution m.
   int quantizeOffset(double s) const;
   double offsetValue(int k) const { return (k - 128) * (0.75 * resolution_ / 127.0); }
@@ -210,11 +223,9 @@ class DpSlamMap : public AncestryHooks {
   void observe(int ix, int iy, int node, const AncestryTree& tree, double d, bool hit);
   /// Writes one beam for cache slot `slot` owned by `node` (cache begun with the current leaves): the
   /// cells crossed get (chord, no hit); for a return, the cell holding the endpoint gets (partial chord, hit).
-  /// The beam is traced up to `max_range` (m); a return beyond it only writes free space. A crossed cell
-  /// whose visible statistics show no hit over at least `free_saturation` m is left as it is (its density
-  /// is 0 either way; this saves a copy per particle of every free cell). 0 = always write.
-  void addBeam(const MapBeam& beam, double max_range, int slot, int node, LookupCache& cache,
-               double free_saturation = 0.0);
+  /// The beam is traced up to `max_range` (m); a return beyond it only writes free space. Crossed cells
+  /// that are saturated free (setFreeSaturation) are left as they are.
+  void addBeam(const MapBeam& beam, double max_range, int slot, int node, LookupCache& cache);
 
   /// addBeam in two phases, so that the expensive part can run in parallel: planBeam (const, thread-safe
   /// with one cache per thread) traces the beam and appends the cell writes to `out`, leaving out crossed
@@ -228,10 +239,9 @@ class DpSlamMap : public AncestryHooks {
     std::uint8_t offset = 0;  ///< a stop's quantised offset along the entry's (new) normal (0 = none), see setSurfaceOffsets
   };
   /// `only_unknown`: cells `slot` already has an entry for are left out as well (the map keeps what it has).
-  void planBeam(const MapBeam& beam, double max_range, int slot, LookupCache& cache, double free_saturation,
-                std::vector<CellWrite>& out, bool only_unknown = false) const;
-  void applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache,
-                   double free_saturation = 0.0);
+  void planBeam(const MapBeam& beam, double max_range, int slot, LookupCache& cache, std::vector<CellWrite>& out,
+                bool only_unknown = false) const;
+  void applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache);
 
   // --- Observation model (const, thread-safe with one cache per thread) ---
   /// log p(beam | map seen by slot), floored at model.log_floor. Traced up to min(range + window, max_range).
@@ -261,9 +271,19 @@ class DpSlamMap : public AncestryHooks {
     std::uint16_t size = 0;
     std::uint8_t cls = 0xFF;  ///< size class of the block (EntryPool::capacity); 0xFF = none
   };
+  /// Tile::free bits (setRoot): the cell holds a root entry, so that every slot sees one, and no entry has
+  /// a hit: its density is 0 for every slot ...
+  static constexpr std::uint8_t kFreeForAll = 1;
+  /// ... and every entry has seen at least the free saturation distance (setFreeSaturation): no write
+  /// changes what any slot sees.
+  static constexpr std::uint8_t kSaturated = 2;
+  /// The bits may be clear where they could be set (a trace then looks the cell up): after a removal they
+  /// are recomputed only in cells left with this many entries or fewer.
+  static constexpr int kFreeRescanSize = 4;
   struct Tile {
     int tx = 0, ty = 0;
     Cell cells[kTileSize * kTileSize];
+    std::uint8_t free[kTileSize * kTileSize] = {};  ///< kFreeForAll | kSaturated per cell, kept by refreshFree
   };
   struct EntryRef {
     std::uint32_t tile;
@@ -284,6 +304,9 @@ class DpSlamMap : public AncestryHooks {
   /// shrinks/frees the block. Does not touch the removed entry's owner list.
   void removeFromCell(int tile, int cell, int slot);
   void removeFromOwner(int owner, std::uint32_t back);
+  /// Recomputes the cell's Tile::free bits after its entries changed.
+  void refreshFree(int tile, int cell);
+  std::uint8_t freeBits(const MapEntry& e) const;  ///< the Tile::free bits a cell holding only e would have
   /// Compacts the entry block classes that have many free blocks (EntryPool::compact). Moves blocks:
   /// only where no entry pointer is held.
   void compactPool();
@@ -308,6 +331,8 @@ class DpSlamMap : public AncestryHooks {
   double surface_depth_ = 0.0;  ///< m, see setSurfaceDepth
   double cell_normal_min_cos_ = 0.0;  ///< see setCellNormals
   bool surface_offsets_ = false;      ///< see setSurfaceOffsets
+  float free_saturation_ = std::numeric_limits<float>::infinity();  ///< m, see setFreeSaturation (inf = off)
+  int root_ = -1;                     ///< see setRoot
   /// Beam parameter t (m) at which a stop in cell (ix, iy) with normal q and offset k counts: the beam's
   /// crossing of the cell's surface line, clamped to [t0, t1]; the chord's middle without one.
   double stopPoint(int ix, int iy, int q, int k, const MapBeam& b, double t0, double t1) const;

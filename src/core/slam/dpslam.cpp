@@ -78,6 +78,7 @@ DpSlam::DpSlam(const DpSlamConfig& config)
   map_.setSurfaceDepth(config_.surface_depth);
   map_.setCellNormals(config_.cell_normal_min_cos);
   map_.setSurfaceOffsets(config_.cell_surface_offsets);
+  map_.setFreeSaturation(config_.free_saturation_distance);
   RevisitDetectorConfig rc;
   rc.radius = config_.revisit_radius;
   rc.min_travel = config_.revisit_min_travel;
@@ -232,8 +233,7 @@ void DpSlam::planWrites(const std::vector<int>& who, const std::vector<Pose2D>& 
   const bool only_unknown = config_.revisit_freeze_map && last_revisit_;
   forEachBeamByBlock(who.size(), update_beams_, [&](std::size_t k, const BaseBeam& b, LookupCache& cache) {
     const int i = who[k];
-    map_.planBeam(toMap(frames[k], b), config_.trace_max_range, i, cache, config_.free_saturation_distance, writes_[i],
-                  only_unknown);
+    map_.planBeam(toMap(frames[k], b), config_.trace_max_range, i, cache, writes_[i], only_unknown);
   });
 }
 
@@ -241,7 +241,7 @@ void DpSlam::applyWrites(const std::vector<int>& who, const std::vector<int>& no
   update_cache_.begin(tree_, nodes);
   for (std::size_t s = 0; s < who.size(); ++s) {
     auto& w = writes_[who[s]];
-    map_.applyWrites(w, static_cast<int>(s), nodes[s], update_cache_, config_.free_saturation_distance);
+    map_.applyWrites(w, static_cast<int>(s), nodes[s], update_cache_);
     // A scan into unmapped space plans ten times the usual writes: no particle keeps a buffer that large.
     if (w.capacity() > kKeptWrites) std::vector<DpSlamMap::CellWrite>().swap(w);
   }
@@ -282,6 +282,7 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
       if (w.strength >= config_.map_wall_min_strength) first = Pose2D(0.0, 0.0, -w.angle);
     }
     const int root = tree_.createRoot(0);
+    map_.setRoot(root);
     poses_.assign(P, first);
     logw_.assign(P, 0.0);
     leaves_ = {root};

@@ -165,6 +165,12 @@ void DpSlamMap::clear() {
   owned_.clear();
   entries_ = 0;
   observed_cells_ = 0;
+  root_ = -1;
+}
+
+void DpSlamMap::setFreeSaturation(double distance) {
+  if (!(distance >= 0.0)) throw std::invalid_argument("DpSlamMap: free saturation must be >= 0");
+  free_saturation_ = distance > 0.0 ? static_cast<float>(distance) : std::numeric_limits<float>::infinity();
 }
 
 int DpSlamMap::tileId(int ix, int iy) const {
@@ -274,7 +280,33 @@ int DpSlamMap::appendEntry(int tile, int cell, const MapEntry& e) {
   if (c.size == 0xFFFF) throw std::length_error("DpSlamMap: too many entries in one cell");
   new (&c.entries[c.size]) MapEntry(e);  // the pool hands out raw pages
   ++entries_;
-  return c.size++;
+  const int slot = c.size++;
+  if (e.owner == root_ || slot == 0) {
+    refreshFree(tile, cell);
+  } else {
+    tiles_[tile]->free[cell] &= freeBits(e);  // an entry more can clear the bits, not set them
+  }
+  return slot;
+}
+
+std::uint8_t DpSlamMap::freeBits(const MapEntry& e) const {
+  if (e.hits != 0.0f) return 0;
+  return e.distance >= free_saturation_ ? (kFreeForAll | kSaturated) : kFreeForAll;
+}
+
+void DpSlamMap::refreshFree(int tile, int cell) {
+  Tile& t = *tiles_[tile];
+  const Cell& c = t.cells[cell];
+  t.free[cell] = 0;
+  if (root_ < 0) return;  // no root told: no bits, every trace looks every cell up
+  // Every slot sees some entry (the root's, at least) and whichever it sees has no hit (and is saturated).
+  std::uint8_t f = kFreeForAll | kSaturated;
+  bool root = false;
+  for (int j = 0; j < c.size && f; ++j) {
+    f &= freeBits(c.entries[j]);
+    root = root || c.entries[j].owner == root_;
+  }
+  t.free[cell] = root ? f : 0;
 }
 
 void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
@@ -298,6 +330,8 @@ void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
   } else if (c.cls > 0 && c.size <= EntryPool::capacity(c.cls - 1) / 2) {
     moveToClass(c, c.cls - 1);
   }
+  // One entry less can only set the bits: recomputed when that is cheap (a cell's branches end in one entry).
+  if (c.size <= kFreeRescanSize) refreshFree(tile, cell);
 }
 
 void DpSlamMap::removeFromOwner(int owner, std::uint32_t back) {
@@ -363,6 +397,7 @@ void DpSlamMap::mergeChildIntoParent(int child, int parent) {
     me.owner = static_cast<std::int16_t>(parent);
     me.back = static_cast<std::uint32_t>(pl.size());
     pl.push_back(cl[i]);
+    if (parent == root_) refreshFree(tile, cell);
   }
   std::vector<EntryRef>().swap(cl);
   compactPool();
@@ -616,6 +651,7 @@ void DpSlamMap::observe(int ix, int iy, int node, const AncestryTree& tree, doub
     MapEntry* m = const_cast<MapEntry*>(vis);
     m->hits += hit ? 1.0f : 0.0f;
     m->distance += static_cast<float>(d);
+    refreshFree(tile, cell);
     return;
   }
   MapEntry ne;
@@ -627,9 +663,12 @@ void DpSlamMap::observe(int ix, int iy, int node, const AncestryTree& tree, doub
   owned_[node].push_back({static_cast<std::uint32_t>(tile), static_cast<std::uint16_t>(cell), static_cast<std::uint16_t>(s)});
 }
 
-void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCache& cache, double free_saturation,
-                         std::vector<CellWrite>& out, bool only_unknown) const {
-  const float saturation = free_saturation > 0.0 ? static_cast<float>(free_saturation) : std::numeric_limits<float>::infinity();
+void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCache& cache, std::vector<CellWrite>& out,
+                         bool only_unknown) const {
+  const float saturation = free_saturation_;
+  // A cell flagged so is seen the same by every slot: saturated free (left out unless it holds the return),
+  // or known at all (left out by only_unknown).
+  const std::uint8_t skip_flag = only_unknown ? kFreeForAll : kSaturated;
   const bool hit = !b.no_return && b.range <= max_range;
   const double length = std::min(b.range, max_range);
   // Near the surface hit, distance counts along its normal (setSurfaceDepth).
@@ -644,7 +683,9 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
     const bool end = hit && t1 >= length;
     int q = 0;  // the cell's normal, if it has statistics
     if ((normals || !end || only_unknown) && seek(cur, ix, iy, cache)) {
-      const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache);
+      const int cell = cellInTile(ix, iy);
+      if ((!end || only_unknown) && (cur.t->free[cell] & skip_flag)) return true;
+      const MapEntry* v = resolve(cur, cell, slot, cache);
       if (v && only_unknown) return true;
       if (v) {
         if (!end && v->hits == 0.0f && v->distance >= saturation) return true;
@@ -673,9 +714,8 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   });
 }
 
-void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache,
-                            double free_saturation) {
-  const float saturation = free_saturation > 0.0 ? static_cast<float>(free_saturation) : std::numeric_limits<float>::infinity();
+void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache) {
+  const float saturation = free_saturation_;
   requireNodeId(node);
   if (static_cast<int>(owned_.size()) <= node) owned_.resize(node + 1);
   Cursor cur;
@@ -697,6 +737,11 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
         v.distance += w.d;
         if (w.normal) v.normal = w.normal;
         v.offset = offset;
+        if (node == root_) {
+          refreshFree(cur.tile, cell);
+        } else {
+          cur.t->free[cell] &= freeBits(v);
+        }
         continue;
       }
       ne.hits = v.hits + w.hit;
@@ -715,11 +760,10 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
   }
 }
 
-void DpSlamMap::addBeam(const MapBeam& b, double max_range, int slot, int node, LookupCache& cache,
-                        double free_saturation) {
+void DpSlamMap::addBeam(const MapBeam& b, double max_range, int slot, int node, LookupCache& cache) {
   std::vector<CellWrite> writes;
-  planBeam(b, max_range, slot, cache, free_saturation, writes);
-  applyWrites(writes, slot, node, cache, free_saturation);
+  planBeam(b, max_range, slot, cache, writes);
+  applyWrites(writes, slot, node, cache);
 }
 
 // --- Observation model -----------------------------------------------------------------------------
@@ -741,7 +785,9 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
     double mu = mu_unknown;
     int q = 0, k = 0;
     if (seek(cur, ix, iy, cache)) {
-      if (const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache)) {
+      const int cell = cellInTile(ix, iy);
+      if (cur.t->free[cell] & kFreeForAll) return true;  // density 0 for every slot: adds nothing
+      if (const MapEntry* v = resolve(cur, cell, slot, cache)) {
         mu = v->density();
         if (normals) q = v->normal;
         if (offsets) k = v->offset;
@@ -782,7 +828,9 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                double mu = mu_unknown;
                int q = 0, k = 0;
                if (seek(cur, ix, iy, cache)) {
-                 if (const MapEntry* v = resolve(cur, cellInTile(ix, iy), slot, cache)) {
+                 const int cell = cellInTile(ix, iy);
+                 if (cur.t->free[cell] & kFreeForAll) return true;  // density 0 for every slot
+                 if (const MapEntry* v = resolve(cur, cell, slot, cache)) {
                    mu = v->density();
                    if (cell_normal_min_cos_ > 0.0) {
                      q = v->normal;
