@@ -1,6 +1,9 @@
 #include "laser_dpslam/scan/saliency_resampler.h"
 
 #include <Eigen/Core>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -214,6 +217,34 @@ void pickSalient(const std::vector<Eigen::Vector2d>& p, const SaliencyFeatures& 
   }
 }
 
+// d2[i] = min(d2[i], |(xs[i], ys[i]) − q|²) for every point; returns the largest d2 (−1 when n = 0). Two
+// points per SSE2 instruction: no index is carried from one point to the next, the arg-max is found after.
+double updateDistances(const double* xs, const double* ys, double qx, double qy, std::size_t n, double* d2) {
+  std::size_t i = 0;
+  double best = -1.0;
+#ifdef __SSE2__
+  const __m128d vqx = _mm_set1_pd(qx), vqy = _mm_set1_pd(qy);
+  __m128d vbest = _mm_set1_pd(-1.0);
+  for (; i + 2 <= n; i += 2) {
+    const __m128d dx = _mm_sub_pd(_mm_loadu_pd(xs + i), vqx), dy = _mm_sub_pd(_mm_loadu_pd(ys + i), vqy);
+    const __m128d d = _mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy));
+    const __m128d m = _mm_min_pd(d, _mm_loadu_pd(d2 + i));  // d < d2 ? d : d2 (−inf stays)
+    _mm_storeu_pd(d2 + i, m);
+    vbest = _mm_max_pd(vbest, m);
+  }
+  double lanes[2];
+  _mm_storeu_pd(lanes, vbest);
+  best = std::max(lanes[0], lanes[1]);
+#endif
+  for (; i < n; ++i) {
+    const double dx = xs[i] - qx, dy = ys[i] - qy;
+    const double d = dx * dx + dy * dy;
+    d2[i] = d < d2[i] ? d : d2[i];
+    best = std::max(best, d2[i]);
+  }
+  return best;
+}
+
 // Phase 2: coverage by farthest-point sampling from what is already chosen, until out holds the budget:
 // spatially uniform, so the dense clusters near the laser do not take the budget (the thesis's URG-04LX
 // problem). O(n) per pick over plain arrays (the scan's hot loop after the NDT score): points that may not
@@ -229,16 +260,11 @@ void coverFarthest(const std::vector<Eigen::Vector2d>& p, const std::vector<char
   }
   // Adds point j to the picks; returns the farthest point from all picks (−1: none left).
   auto pick = [&](std::size_t j) {
-    const double qx = xs[j], qy = ys[j];
-    int best = -1;
-    double best_d = -1.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double dx = xs[i] - qx, dy = ys[i] - qy;
-      const double d = std::min(dist2[i], dx * dx + dy * dy);
-      dist2[i] = d;
-      if (d > best_d) best_d = d, best = static_cast<int>(i);
-    }
-    return best;
+    const double best_d = updateDistances(xs.data(), ys.data(), xs[j], ys[j], n, dist2.data());
+    if (!(best_d > -1.0)) return -1;
+    std::size_t best = 0;  // the first point at the maximum, as a single arg-max pass would find
+    while (dist2[best] != best_d) ++best;
+    return static_cast<int>(best);
   };
   int best = -1;
   if (out.empty()) {
