@@ -129,9 +129,11 @@ TEST(DpSlamMap, EntriesFollowTheAncestry) {
   EXPECT_EQ(map.check(), "");
 }
 
-TEST(DpSlamMap, CachedLookupsEqualReferenceLookups) {
-  World w(9, 5);
-  for (int step = 2; step < 40; ++step) {
+// With up to 64 particles a cell's row comes from the slots' masks, above that from ancestry walks: both
+// sizes are checked against the reference look-up.
+void expectCachedLookupsEqualReferenceLookups(int particles, int steps) {
+  World w(particles, 5);
+  for (int step = 2; step < steps; ++step) {
     w.writeRandom(20);
     w.leaves = w.tree.advance(w.leaves, w.randomParents(), step, w.map);
     LookupCache cache;
@@ -147,6 +149,13 @@ TEST(DpSlamMap, CachedLookupsEqualReferenceLookups) {
     }
   }
 }
+
+TEST(DpSlamMap, CachedLookupsEqualReferenceLookups) {
+  expectCachedLookupsEqualReferenceLookups(9, 40);
+  expectCachedLookupsEqualReferenceLookups(64, 15);
+}
+
+TEST(DpSlamMap, CachedLookupsEqualReferenceLookupsBeyond64Particles) { expectCachedLookupsEqualReferenceLookups(70, 15); }
 
 // The free-cell bits (setRoot) only skip look-ups: two maps with the same history, one told the tree's root,
 // score and plan every beam for every particle the same, through writes, hits, saturation, pruning and

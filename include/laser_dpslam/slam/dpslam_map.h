@@ -130,6 +130,12 @@ class LookupCache {
   std::vector<std::int32_t> memo_;                 ///< by node ID, while building a row
   std::vector<std::uint32_t> memo_stamp_;
   std::uint32_t memo_counter_ = 0;
+  /// With at most 64 slots, by node ID: the slots whose node is this one or descends from it, and the node's
+  /// depth below the root. A row is then built from the cell's entries alone: each entry's owner claims its
+  /// slots, the deepest owner (the nearest ancestor) wins.
+  std::vector<std::uint64_t> descendants_;
+  std::vector<std::int32_t> depth_;
+  bool slot_masks_ = false;
 };
 
 /// The shared map. Thread safety: const member functions (scoring, lookups) may run concurrently, each
@@ -324,6 +330,10 @@ class DpSlamMap : public AncestryHooks {
   MapEntry* resolve(const Cursor& cur, int cell, int slot, LookupCache& cache) const;
   const MapEntry* visibleCached(int tile, int cell, int slot, LookupCache& cache) const;
   void buildRow(int tile, int cell, LookupCache& cache) const;
+  /// The entry index each slot sees in cell c (-1 = none), into out: from the slots' masks (LookupCache::
+  /// descendants_), or by walking each slot's ancestry up to a node with an entry (memoised per cell).
+  void rowFromMasks(const Cell& c, const LookupCache& cache, std::int16_t* out) const;
+  void rowFromWalks(const Cell& c, LookupCache& cache, std::int16_t* out) const;
   static void setRowSlot(LookupCache& cache, int tile, int cell, int slot, int value);
 
   double resolution_;

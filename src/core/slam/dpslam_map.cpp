@@ -127,6 +127,20 @@ void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_n
     memo_.resize(tree.idCapacity(), -1);
     memo_stamp_.resize(tree.idCapacity(), 0);
   }
+  slot_masks_ = slot_nodes_.size() <= 64;
+  if (slot_masks_) {
+    descendants_.assign(parent_.size(), 0);
+    depth_.assign(parent_.size(), -1);
+    for (std::size_t s = 0; s < slot_nodes_.size(); ++s) {
+      for (int n = slot_nodes_[s]; n >= 0; n = parent_[n]) descendants_[n] |= std::uint64_t{1} << s;
+    }
+    for (std::size_t i = 0; i < parent_.size(); ++i) {
+      if (!descendants_[i]) continue;
+      int d = 0;
+      for (int n = parent_[i]; n >= 0; n = parent_[n]) ++d;
+      depth_[i] = d;
+    }
+  }
   rows_.clear();
   // The rows of a tile no trace entered for a while go: the cache follows the robot, not the whole map.
   for (auto& t : tiles_) {
@@ -145,7 +159,8 @@ std::size_t LookupCache::memoryBytes() const {
   for (const auto& t : tiles_) {
     if (t) b += sizeof(TileRows);
   }
-  return b + (memo_.capacity() + memo_stamp_.capacity()) * 4 + (slot_nodes_.capacity() + parent_.capacity()) * sizeof(int);
+  return b + (memo_.capacity() + memo_stamp_.capacity() + depth_.capacity()) * 4 + descendants_.capacity() * 8 +
+         (slot_nodes_.capacity() + parent_.capacity()) * sizeof(int);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -462,10 +477,52 @@ constexpr std::uint32_t kUniform = 0x80000000u;  ///< row word flag: every slot 
 
 void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
   const Cell& c = tiles_[tile]->cells[cell];
-  const MapEntry* e = entriesOf(c);
   const std::size_t slots = cache.slot_nodes_.size();
   cache.scratch_.resize(slots);
   std::int16_t* out = cache.scratch_.data();
+  if (cache.slot_masks_) {
+    rowFromMasks(c, cache, out);
+  } else {
+    rowFromWalks(c, cache, out);
+  }
+  bool uniform = true;
+  for (std::size_t s = 1; s < slots && uniform; ++s) uniform = out[s] == out[0];
+  LookupCache::TileRows& tr = *cache.tiles_[tile];
+  tr.cells[cell].stamp = cache.stamp_;
+  if (uniform && slots > 0) {
+    tr.cells[cell].row = kUniform | static_cast<std::uint32_t>(out[0] + 1);
+  } else {
+    tr.cells[cell].row = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
+    cache.rows_.insert(cache.rows_.end(), out, out + slots);
+  }
+}
+
+void DpSlamMap::rowFromMasks(const Cell& c, const LookupCache& cache, std::int16_t* out) const {
+  const MapEntry* e = entriesOf(c);
+  const std::size_t slots = cache.slot_nodes_.size();
+  std::int32_t best_depth[64];
+  for (std::size_t s = 0; s < slots; ++s) {
+    out[s] = -1;
+    best_depth[s] = -1;
+  }
+  // Each entry claims the slots that descend from its owner; the deepest owner, the nearest ancestor, wins.
+  for (int j = 0; j < c.size; ++j) {
+    const int o = e[j].owner;
+    if (o >= static_cast<int>(cache.descendants_.size())) continue;
+    const std::int32_t d = cache.depth_[o];
+    for (std::uint64_t m = cache.descendants_[o]; m; m &= m - 1) {
+      const int s = __builtin_ctzll(m);
+      if (d > best_depth[s]) {
+        best_depth[s] = d;
+        out[s] = static_cast<std::int16_t>(j);
+      }
+    }
+  }
+}
+
+void DpSlamMap::rowFromWalks(const Cell& c, LookupCache& cache, std::int16_t* out) const {
+  const MapEntry* e = entriesOf(c);
+  const std::size_t slots = cache.slot_nodes_.size();
   if (++cache.memo_counter_ == 0) {  // wrapped
     std::fill(cache.memo_stamp_.begin(), cache.memo_stamp_.end(), 0u);
     cache.memo_counter_ = 1;
@@ -480,7 +537,6 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
   }
   int stack[64];
   std::vector<int> big_stack;
-  bool uniform = true;
   for (std::size_t s = 0; s < slots; ++s) {
     int n = cache.slot_nodes_[s];
     int depth = 0;
@@ -501,15 +557,6 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
       cache.memo_stamp_[x] = mark;
     }
     out[s] = static_cast<std::int16_t>(cache.memo_[cache.slot_nodes_[s]]);
-    uniform = uniform && out[s] == out[0];
-  }
-  LookupCache::TileRows& tr = *cache.tiles_[tile];
-  tr.cells[cell].stamp = cache.stamp_;
-  if (uniform && slots > 0) {
-    tr.cells[cell].row = kUniform | static_cast<std::uint32_t>(out[0] + 1);
-  } else {
-    tr.cells[cell].row = static_cast<std::uint32_t>(cache.rows_.size() / (slots ? slots : 1));
-    cache.rows_.insert(cache.rows_.end(), out, out + slots);
   }
 }
 
