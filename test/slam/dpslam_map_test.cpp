@@ -522,6 +522,32 @@ int normalSeen(const DpSlamMap& map, int ix, int iy, int node, const AncestryTre
   return e ? e->normal : 0;
 }
 
+// The quantisers avoid fmod and round where they can: the same bins as the library definitions, at the
+// folds (±π, ±2π), at halves, and far out.
+TEST(DpSlamMap, QuantisersEqualTheirLibraryDefinitions) {
+  auto angleByFmod = [](double a) {
+    a = std::fmod(a, M_PI);
+    if (a < 0.0) a += M_PI;
+    if (a >= M_PI) a -= M_PI;
+    return std::min(255, 1 + static_cast<int>(a * (255.0 / M_PI)));
+  };
+  const DpSlamMap map(0.05, 4.0);
+  auto offsetByRound = [&](double s) {
+    const double k = std::round(s * (127.0 / (0.75 * 0.05))) + 128.0;
+    return static_cast<int>(std::min(255.0, std::max(1.0, k)));
+  };
+  std::vector<double> angles{M_PI, -M_PI, 2.0 * M_PI, -2.0 * M_PI, std::nextafter(M_PI, 0.0), std::nextafter(2.0 * M_PI, 0.0),
+                             std::nextafter(-2.0 * M_PI, 0.0), 7.5, -7.5, 1e6, -0.0};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-7.0, 7.0);
+  for (int i = 0; i < 20000; ++i) angles.push_back(u(rng));
+  for (double a : angles) EXPECT_EQ(DpSlamMap::quantizeNormalAngle(a), angleByFmod(a)) << a;
+  const double unit = 0.75 * 0.05 / 127.0;  // one offset step (m)
+  std::vector<double> offsets{0.5 * unit, -0.5 * unit, 1.5 * unit, -1.5 * unit, 0.0, -0.0, 1.0, -1.0, 1e20};
+  for (int i = 0; i < 20000; ++i) offsets.push_back(0.01 * u(rng));
+  for (double s : offsets) EXPECT_EQ(map.quantizeOffset(s), offsetByRound(s)) << s;
+}
+
 // setCellNormals: the cell a beam stops in takes the beam's surface normal; afterwards every beam crossing
 // that cell counts its chord times |cos| to that normal (bounded below), in writes and in scores; off (0)
 // by default, and then nothing changes.

@@ -634,14 +634,27 @@ int DpSlamMap::quantizeNormal(double nx, double ny) {
 
 int DpSlamMap::quantizeNormalAngle(double a) {
   if (std::isnan(a)) return 0;
-  a = std::fmod(a, M_PI);  // a normal's sign does not matter: angle modulo π
+  // A normal's sign does not matter: angle modulo π. Angles within ±2π (a scan's normal plus a heading)
+  // take a subtraction, exact there as fmod is (Sterbenz), instead of fmod's library call.
+  if (!(std::abs(a) < M_PI)) a = std::abs(a) < 2.0 * M_PI ? a - std::copysign(M_PI, a) : std::fmod(a, M_PI);
   if (a < 0.0) a += M_PI;
   if (a >= M_PI) a -= M_PI;
   return std::min(255, 1 + static_cast<int>(a * (255.0 / M_PI)));
 }
 
+namespace {
+/// std::round (halves away from zero) without the library call where |x| < 2^52: the truncation and the
+/// fraction x − trunc(x) are exact there.
+double roundHalfAway(double x) {
+  if (!(std::abs(x) < 0x1p52)) return std::round(x);
+  const double t = static_cast<double>(static_cast<long long>(x));
+  const double f = x - t;
+  return f >= 0.5 ? t + 1.0 : (f <= -0.5 ? t - 1.0 : t);
+}
+}  // namespace
+
 int DpSlamMap::quantizeOffset(double s) const {
-  const double k = std::round(s * (127.0 / (0.75 * resolution_))) + 128.0;
+  const double k = roundHalfAway(s * (127.0 / (0.75 * resolution_))) + 128.0;
   return static_cast<int>(std::min(255.0, std::max(1.0, k)));
 }
 
