@@ -157,38 +157,67 @@ TEST(DpSlamMap, CachedLookupsEqualReferenceLookups) {
 
 TEST(DpSlamMap, CachedLookupsEqualReferenceLookupsBeyond64Particles) { expectCachedLookupsEqualReferenceLookups(70, 15); }
 
+namespace {
+// Beams in a 2.4 m square room (so that scores are not all at the floor), from (ox, oy) at angle a.
+MapBeam roomBeam(double ox, double oy, double a, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  MapBeam b;
+  b.ox = ox;
+  b.oy = oy;
+  b.dx = std::cos(a);
+  b.dy = std::sin(a);
+  const double tx = std::abs(b.dx) > 1e-9 ? ((b.dx > 0.0 ? 1.2 : -1.2) - ox) / b.dx : 1e9;
+  const double ty = std::abs(b.dy) > 1e-9 ? ((b.dy > 0.0 ? 1.2 : -1.2) - oy) / b.dy : 1e9;
+  b.range = std::min(tx, ty) + 0.02 * (u(rng) - 0.5);
+  b.no_return = u(rng) < 0.1;
+  return b;
+}
+
+// One map with its tree and particles, written as DpSlam writes it.
+struct MapSide {
+  AncestryTree tree;
+  DpSlamMap map{0.1, 4.0};
+  std::vector<int> leaves;
+  LookupCache cache;  ///< begun with the leaves by plan()
+  explicit MapSide(bool tell_root) {
+    map.setFreeSaturation(0.8);  // above the prior (0.4 m): a cell is passed a few times before it saturates
+    leaves = {tree.createRoot()};
+    if (tell_root) map.setRoot(leaves[0]);
+  }
+  std::vector<std::vector<DpSlamMap::CellWrite>> plan(const std::vector<std::vector<MapBeam>>& beams, bool only_unknown) {
+    cache.begin(tree, leaves);
+    std::vector<std::vector<DpSlamMap::CellWrite>> plans(leaves.size());
+    for (std::size_t k = 0; k < leaves.size(); ++k) {
+      for (const MapBeam& b : beams[k]) map.planBeam(b, 20.0, static_cast<int>(k), cache, plans[k], only_unknown);
+    }
+    return plans;
+  }
+  // Each surviving lineage writes its plan into the node it owns after the advance.
+  void advanceAndWrite(const std::vector<int>& parents, int generation,
+                       const std::vector<std::vector<DpSlamMap::CellWrite>>& plans) {
+    std::vector<int> lineage;
+    const std::size_t old = leaves.size();
+    leaves = tree.advance(leaves, parents, generation, map, &lineage);
+    std::vector<int> who, nodes;
+    for (std::size_t i = 0; i < old; ++i) {
+      if (std::find(parents.begin(), parents.end(), static_cast<int>(i)) == parents.end()) continue;
+      who.push_back(static_cast<int>(i));
+      nodes.push_back(lineage[i]);
+    }
+    LookupCache writes;
+    writes.begin(tree, nodes);
+    for (std::size_t k = 0; k < who.size(); ++k) map.applyWrites(plans[who[k]], static_cast<int>(k), nodes[k], writes);
+  }
+};
+}  // namespace
+
 // The free-cell bits (setRoot) only skip look-ups: two maps with the same history, one told the tree's root,
 // score and plan every beam for every particle the same, through writes, hits, saturation, pruning and
 // lineages merging into the root.
 TEST(DpSlamMap, FreeCellBitsChangeNoScoreAndNoWrite) {
-  struct Side {
-    AncestryTree tree;
-    DpSlamMap map{0.1, 4.0};
-    std::vector<int> leaves;
-  };
-  Side with, without;
-  for (Side* s : {&with, &without}) {
-    s->map.setFreeSaturation(0.8);  // above the prior (0.4 m): a cell is passed a few times before it saturates
-    const int root = s->tree.createRoot();
-    s->leaves = {root};
-  }
-  with.map.setRoot(with.leaves[0]);
+  MapSide with(true), without(false);
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  // Beams in a 2.4 m square room (so that scores are not all at the floor), from a particle's position:
-  // each particle's beams start a few centimetres apart, so each lineage knows cells the others do not.
-  auto roomBeam = [&](double ox, double oy, double a) {
-    MapBeam b;
-    b.ox = ox;
-    b.oy = oy;
-    b.dx = std::cos(a);
-    b.dy = std::sin(a);
-    const double tx = std::abs(b.dx) > 1e-9 ? ((b.dx > 0.0 ? 1.2 : -1.2) - ox) / b.dx : 1e9;
-    const double ty = std::abs(b.dy) > 1e-9 ? ((b.dy > 0.0 ? 1.2 : -1.2) - oy) / b.dy : 1e9;
-    b.range = std::min(tx, ty) + 0.02 * (u(rng) - 0.5);
-    b.no_return = u(rng) < 0.1;
-    return b;
-  };
   const BeamModelConfig model;
   const int P = 8;
   std::size_t compared = 0;
@@ -196,59 +225,35 @@ TEST(DpSlamMap, FreeCellBitsChangeNoScoreAndNoWrite) {
     std::vector<int> parents(P);
     const int spread = step % 5 == 0 ? 1 : (step % 3 == 0 ? P / 3 : P);  // now and then, one survivor
     for (int j = 0; j < P; ++j) parents[j] = step == 1 ? 0 : static_cast<int>(rng() % spread);
+    // Each particle's beams start a few centimetres apart, so each lineage knows cells the others do not.
     const double cx = 0.6 * (u(rng) - 0.5), cy = 0.6 * (u(rng) - 0.5);
     std::vector<std::vector<MapBeam>> beams(with.leaves.size());
     for (auto& bs : beams) {
       const double ox = cx + 0.1 * (u(rng) - 0.5), oy = cy + 0.1 * (u(rng) - 0.5);
       // A scan: in angle order, so that a lineage passes a cell by one beam and stops in it by the next.
-      for (int n = 0; n < 120; ++n) bs.push_back(roomBeam(ox, oy, 2.0 * M_PI * (n + u(rng)) / 120.0));
+      for (int n = 0; n < 120; ++n) bs.push_back(roomBeam(ox, oy, 2.0 * M_PI * (n + u(rng)) / 120.0, rng));
     }
-    std::vector<LookupCache> caches(2);
-    std::vector<std::vector<DpSlamMap::CellWrite>> plans[2];
-    int side = 0;
-    for (Side* s : {&with, &without}) {
-      LookupCache& cache = caches[side];
-      cache.begin(s->tree, s->leaves);
-      plans[side].resize(s->leaves.size());
-      for (std::size_t k = 0; k < s->leaves.size(); ++k) {
-        for (const MapBeam& b : beams[k]) s->map.planBeam(b, 20.0, static_cast<int>(k), cache, plans[side][k], step % 7 == 0);
-      }
-      ++side;
-    }
+    const auto plans_with = with.plan(beams, step % 7 == 0), plans_without = without.plan(beams, step % 7 == 0);
     for (std::size_t k = 0; k < with.leaves.size(); ++k) {
-      ASSERT_EQ(plans[0][k].size(), plans[1][k].size()) << "step " << step;
-      for (std::size_t i = 0; i < plans[0][k].size(); ++i) {
-        const auto &a = plans[0][k][i], &b = plans[1][k][i];
+      ASSERT_EQ(plans_with[k].size(), plans_without[k].size()) << "step " << step;
+      for (std::size_t i = 0; i < plans_with[k].size(); ++i) {
+        const auto &a = plans_with[k][i], &b = plans_without[k][i];
         ASSERT_TRUE(a.ix == b.ix && a.iy == b.iy && a.d == b.d && a.hit == b.hit) << "step " << step;
       }
       for (int n = 0; n < 20; ++n) {
-        const MapBeam b = roomBeam(cx + 0.1 * (u(rng) - 0.5), cy + 0.1 * (u(rng) - 0.5), 2.0 * M_PI * u(rng));
+        const MapBeam b = roomBeam(cx + 0.1 * (u(rng) - 0.5), cy + 0.1 * (u(rng) - 0.5), 2.0 * M_PI * u(rng), rng);
         const int slot = static_cast<int>(k);
-        ASSERT_EQ(with.map.beamLogLikelihood(b, 20.0, slot, caches[0], model),
-                  without.map.beamLogLikelihood(b, 20.0, slot, caches[1], model)) << "step " << step;
-        ASSERT_EQ(with.map.beamEndpointLogLikelihood(b, 0.25, slot, caches[0], model),
-                  without.map.beamEndpointLogLikelihood(b, 0.25, slot, caches[1], model)) << "step " << step;
+        ASSERT_EQ(with.map.beamLogLikelihood(b, 20.0, slot, with.cache, model),
+                  without.map.beamLogLikelihood(b, 20.0, slot, without.cache, model)) << "step " << step;
+        ASSERT_EQ(with.map.beamEndpointLogLikelihood(b, 0.25, slot, with.cache, model),
+                  without.map.beamEndpointLogLikelihood(b, 0.25, slot, without.cache, model)) << "step " << step;
         ++compared;
       }
     }
-    // Each surviving lineage writes its plan into the node it owns after the advance (as DpSlam does).
-    side = 0;
-    for (Side* s : {&with, &without}) {
-      std::vector<int> lineage;
-      const std::vector<int> old = s->leaves;
-      s->leaves = s->tree.advance(s->leaves, parents, step + 1, s->map, &lineage);
-      std::vector<int> who, nodes;
-      for (std::size_t i = 0; i < old.size(); ++i) {
-        if (std::find(parents.begin(), parents.end(), static_cast<int>(i)) == parents.end()) continue;
-        who.push_back(static_cast<int>(i));
-        nodes.push_back(lineage[i]);
-      }
-      LookupCache cache;
-      cache.begin(s->tree, nodes);
-      for (std::size_t k = 0; k < who.size(); ++k) s->map.applyWrites(plans[side][who[k]], static_cast<int>(k), nodes[k], cache);
-      ASSERT_EQ(s->map.check(), "") << "step " << step;
-      ++side;
-    }
+    with.advanceAndWrite(parents, step + 1, plans_with);
+    without.advanceAndWrite(parents, step + 1, plans_without);
+    ASSERT_EQ(with.map.check(), "") << "step " << step;
+    ASSERT_EQ(without.map.check(), "") << "step " << step;
     ASSERT_EQ(with.map.entryCount(), without.map.entryCount()) << "step " << step;
   }
   EXPECT_GT(compared, 0u);

@@ -312,7 +312,9 @@ class DpSlamMap : public AncestryHooks {
   void removeFromOwner(int owner, std::uint32_t back);
   /// Recomputes the cell's Tile::free bits after its entries changed.
   void refreshFree(int tile, int cell);
-  std::uint8_t freeBits(const MapEntry& e) const;  ///< the Tile::free bits a cell holding only e would have
+  /// The Tile::free bits a cell holding only e would have; kSaturated is also the per-entry rule by which
+  /// planBeam and applyWrites leave a crossed cell as it is.
+  std::uint8_t freeBits(const MapEntry& e) const;
   /// Compacts the entry block classes that have many free blocks (EntryPool::compact). Moves blocks:
   /// only where no entry pointer is held.
   void compactPool();

@@ -725,7 +725,6 @@ void DpSlamMap::observe(int ix, int iy, int node, const AncestryTree& tree, doub
 
 void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCache& cache, std::vector<CellWrite>& out,
                          bool only_unknown) const {
-  const float saturation = free_saturation_;
   // A cell flagged so is seen the same by every slot: saturated free (left out unless it holds the return),
   // or known at all (left out by only_unknown).
   const std::uint8_t skip_flag = only_unknown ? kFreeForAll : kSaturated;
@@ -748,7 +747,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
       const MapEntry* v = resolve(cur, cell, slot, cache);
       if (v && only_unknown) return true;
       if (v) {
-        if (!end && v->hits == 0.0f && v->distance >= saturation) return true;
+        if (!end && (freeBits(*v) & kSaturated)) return true;
         if (normals) q = v->normal;
       }
     }
@@ -775,7 +774,6 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
 }
 
 void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache) {
-  const float saturation = free_saturation_;
   requireNodeId(node);
   if (static_cast<int>(owned_.size()) <= node) owned_.resize(node + 1);
   Cursor cur;
@@ -789,7 +787,7 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
     ne.offset = w.offset;
     if (vis) {
       MapEntry& v = *vis;
-      if (w.hit == 0 && v.hits == 0.0f && v.distance >= saturation) continue;
+      if (w.hit == 0 && (freeBits(v) & kSaturated)) continue;
       const int nq = w.normal ? w.normal : v.normal;
       const std::uint8_t offset = w.offset ? meanOffset(v.normal, v.offset, v.hits, nq, w.offset) : v.offset;
       if (v.owner == node) {
