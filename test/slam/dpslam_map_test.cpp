@@ -105,6 +105,72 @@ TEST(TraceCells, ChordsMatchDenseSamplingOfTheRay) {
   }
 }
 
+// A callback that skips blocks sees the cells outside them exactly as a trace that visits every cell: the same
+// cells with bit-identical chords, on rays in every direction (axis-parallel ones too) across negative cells.
+TEST(TraceCells, SkippedBlocksLeaveTheOtherCellsExactlyAsTraced) {
+  struct Visit {
+    int ix, iy;
+    double t0, t1;
+    bool operator==(const Visit& o) const { return ix == o.ix && iy == o.iy && t0 == o.t0 && t1 == o.t1; }
+  };
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 1 << kTraceBlockShift;
+  auto blockOf = [n](int ix, int iy) { return std::make_pair(ix & ~(n - 1), iy & ~(n - 1)); };
+  int skips = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    double a = M_PI * u(rng), res = 0.05;
+    double ox = 2.0 * u(rng), oy = 2.0 * u(rng);
+    const double len = 4.0 * (u(rng) + 1.0);
+    if (trial % 10 == 0) a = M_PI * 0.5 * (trial / 10 % 4);  // along an axis
+    double dx = std::cos(a), dy = std::sin(a);
+    if (trial % 10 == 1) {  // diagonal from a cell corner: x and y crossings at the same times (ties)
+      res = 0.0625;
+      ox = std::round(ox * 16.0) / 16.0;
+      oy = std::round(oy * 16.0) / 16.0;
+      dx = (trial / 10 % 2 ? -1.0 : 1.0) * std::sqrt(0.5);
+      dy = (trial / 20 % 2 ? -1.0 : 1.0) * std::sqrt(0.5);
+    }
+    // Each block of cells is skippable or not, at random (a hash of its corner).
+    const std::uint64_t salt = rng();
+    auto skippable = [&](int ix, int iy) {
+      const auto b = blockOf(ix, iy);
+      std::uint64_t h = salt ^ (static_cast<std::uint64_t>(b.first) * 0x9E3779B97F4A7C15ull) ^
+                        (static_cast<std::uint64_t>(b.second) * 0xC2B2AE3D27D4EB4Full);
+      h ^= h >> 31;
+      return (h * 0xD6E8FEB86659FD93ull) >> 63;
+    };
+    std::vector<Visit> all, visited;
+    traceCells(ox, oy, dx, dy, 0.0, len, res, [&](int ix, int iy, double t0, double t1) {
+      all.push_back({ix, iy, t0, t1});
+      return true;
+    });
+    traceCells(ox, oy, dx, dy, 0.0, len, res, [&](int ix, int iy, double t0, double t1) -> int {
+      visited.push_back({ix, iy, t0, t1});
+      return skippable(ix, iy) ? kTraceSkipBlock : kTraceNext;
+    });
+    // What the skips should leave: after a skippable cell, its block's other cells go, unless the segment
+    // ends inside the block.
+    std::vector<Visit> expected;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      expected.push_back(all[i]);
+      if (!skippable(all[i].ix, all[i].iy)) continue;
+      const auto b = blockOf(all[i].ix, all[i].iy);
+      std::size_t j = i + 1;
+      while (j < all.size() && blockOf(all[j].ix, all[j].iy) == b) ++j;
+      if (j == all.size()) {  // ends inside: cell by cell
+        expected.insert(expected.end(), all.begin() + static_cast<long>(i) + 1, all.end());
+        break;
+      }
+      skips += j > i + 1;
+      i = j - 1;
+    }
+    ASSERT_EQ(visited.size(), expected.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < visited.size(); ++i) ASSERT_TRUE(visited[i] == expected[i]) << "trial " << trial << " cell " << i;
+  }
+  EXPECT_GT(skips, 2000);
+}
+
 TEST(DpSlamMap, EntriesFollowTheAncestry) {
   AncestryTree tree;
   DpSlamMap map(0.1, 4.0);
@@ -170,6 +236,7 @@ MapBeam roomBeam(double ox, double oy, double a, std::mt19937_64& rng) {
   const double ty = std::abs(b.dy) > 1e-9 ? ((b.dy > 0.0 ? 1.2 : -1.2) - oy) / b.dy : 1e9;
   b.range = std::min(tx, ty) + 0.02 * (u(rng) - 0.5);
   b.no_return = u(rng) < 0.1;
+  if (u(rng) < 0.03) b.range *= u(rng);  // something in the room: stops in cells free until now
   return b;
 }
 

@@ -30,11 +30,54 @@ struct MapEntry {
   double density() const { return hits > 0.0f ? static_cast<double>(hits) / distance : 0.0; }  ///< 1/m
 };
 
+/// What a traceCells callback returns: stop, go on to the next cell, or skip the rest of the cell's block.
+enum TraceStep : int { kTraceStop = 0, kTraceNext = 1, kTraceSkipBlock = 2 };
+/// Blocks of (1 << kTraceBlockShift)² cells, aligned on multiples of that size: the unit kTraceSkipBlock skips.
+constexpr int kTraceBlockShift = 3;
+
+/// traceCells' skip: moves the traversal state (cell, entry time, next crossings) to the first cell past the
+/// block of (ix, iy), exactly as the cell-by-cell steps would (the same additions in the same order, the same
+/// tie rule: at equal crossing times the y step comes first). Returns false, changing nothing, when the
+/// segment ends inside the block.
+inline bool skipBlock(int sx, int sy, double tdx, double tdy, double t_end, int& ix, int& iy, double& t, double& tmx,
+                      double& tmy) {
+  constexpr int kLast = (1 << kTraceBlockShift) - 1;
+  const int bx = ix & ~kLast, by = iy & ~kLast;
+  const int nx = sx > 0 ? bx + kLast - ix + 1 : ix - bx + 1;  // x crossings until the block is left in x
+  const int ny = sy > 0 ? by + kLast - iy + 1 : iy - by + 1;
+  double ex = tmx, ey = tmy;  // the time of the leaving crossing in x, in y
+  for (int k = 1; k < nx; ++k) ex += tdx;
+  for (int k = 1; k < ny; ++k) ey += tdy;
+  if (ex < ey) {  // leaves in x; the y crossings before it stay inside
+    if (!(ex < t_end)) return false;
+    while (tmy <= ex) {
+      iy += sy;
+      tmy += tdy;
+    }
+    ix += sx * nx;
+    t = ex;
+    tmx = ex + tdx;
+  } else {
+    if (!(ey < t_end)) return false;
+    while (tmx < ey) {
+      ix += sx;
+      tmx += tdx;
+    }
+    iy += sy * ny;
+    t = ey;
+    tmy = ey + tdy;
+  }
+  return true;
+}
+
 /// Exact grid traversal (Amanatides & Woo 1987) of the segment t ∈ [t_begin, t_end] (m) of the ray
 /// origin + t·dir (origin in m, dir a unit vector) on a grid of `resolution` m whose cell (ix, iy) covers
 /// [ix·res, (ix+1)·res) × [iy·res, (iy+1)·res). Calls f(ix, iy, t0, t1) for every cell the segment crosses,
 /// in order, with t0 < t1 the part of the segment inside it (so t1 − t0 is the chord length); stops early
-/// when f returns false.
+/// when f returns false (kTraceStop). When f returns kTraceSkipBlock, the trace goes on at the first cell
+/// past the 8 × 8 block holding this one, without calling f for the block's other cells, provided the
+/// segment leaves the block (else it goes on cell by cell to its end). The skip repeats the additions the
+/// cell-by-cell steps would make, so the cells and chords after it are the same to the last bit.
 template <class F>
 inline void traceCells(double ox, double oy, double dx, double dy, double t_begin, double t_end, double resolution,
                        F&& f) {
@@ -53,9 +96,15 @@ inline void traceCells(double ox, double oy, double dx, double dy, double t_begi
   double tmx = dx != 0.0 ? t_begin + (dx > 0.0 ? (ix + 1 - px) : (px - ix)) * tdx : kInf;
   double tmy = dy != 0.0 ? t_begin + (dy > 0.0 ? (iy + 1 - py) : (py - iy)) * tdy : kInf;
   double t = t_begin;
+  bool may_skip = true;  // false once the segment is known to end inside the current block
   for (;;) {
     const double tn = std::min(std::min(tmx, tmy), t_end);
-    if (tn > t && !f(ix, iy, t, tn)) return;
+    if (tn > t) {
+      const int r = static_cast<int>(f(ix, iy, t, tn));
+      if (r == kTraceStop) return;
+      if (r == kTraceSkipBlock && may_skip && skipBlock(sx, sy, tdx, tdy, t_end, ix, iy, t, tmx, tmy)) continue;
+      if (r == kTraceSkipBlock) may_skip = false;
+    }
     if (tn >= t_end) return;
     if (tmx < tmy) {
       ix += sx;
@@ -286,11 +335,23 @@ class DpSlamMap : public AncestryHooks {
   /// The bits may be clear where they could be set (a trace then looks the cell up): after a removal they
   /// are recomputed only in cells left with this many entries or fewer.
   static constexpr int kFreeRescanSize = 4;
+  static constexpr int kBlockCells = 1 << kTraceBlockShift;
+  static constexpr int kBlocksPerTile = (kTileSize / kBlockCells) * (kTileSize / kBlockCells);
+  static int blockOf(int cell) {
+    return ((cell >> (kTileShift + kTraceBlockShift)) * (kTileSize / kBlockCells)) |
+           ((cell & (kTileSize - 1)) >> kTraceBlockShift);
+  }
+
   struct Tile {
     int tx = 0, ty = 0;
     Cell cells[kTileSize * kTileSize];
     std::uint8_t free[kTileSize * kTileSize] = {};  ///< kFreeForAll | kSaturated per cell, kept by refreshFree
+    /// The bits every cell of a block of the traces' size (kTraceBlockShift) has: a trace that needs
+    /// neither kind of cell skips the block at once (traceCells' kTraceSkipBlock).
+    std::uint8_t block_free[kBlocksPerTile] = {};
   };
+  /// A cell's Tile::free bits can only drop to `bits` (an entry appended or changed): its block's with them.
+  static void lowerFree(Tile& t, int cell, std::uint8_t bits);
   struct EntryRef {
     std::uint32_t tile;
     std::uint16_t cell;

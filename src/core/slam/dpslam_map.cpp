@@ -299,7 +299,7 @@ int DpSlamMap::appendEntry(int tile, int cell, const MapEntry& e) {
   if (e.owner == root_ || slot == 0) {
     refreshFree(tile, cell);
   } else {
-    tiles_[tile]->free[cell] &= freeBits(e);  // an entry more can clear the bits, not set them
+    lowerFree(*tiles_[tile], cell, freeBits(e));  // an entry more can clear the bits, not set them
   }
   return slot;
 }
@@ -309,10 +309,17 @@ std::uint8_t DpSlamMap::freeBits(const MapEntry& e) const {
   return e.distance >= free_saturation_ ? (kFreeForAll | kSaturated) : kFreeForAll;
 }
 
+void DpSlamMap::lowerFree(Tile& t, int cell, std::uint8_t bits) {
+  t.free[cell] &= bits;
+  t.block_free[blockOf(cell)] &= t.free[cell];
+}
+
 void DpSlamMap::refreshFree(int tile, int cell) {
   Tile& t = *tiles_[tile];
   const Cell& c = t.cells[cell];
+  const int b = blockOf(cell);
   t.free[cell] = 0;
+  t.block_free[b] = 0;
   if (root_ < 0) return;  // no root told: no bits, every trace looks every cell up
   // Every slot sees some entry (the root's, at least) and whichever it sees has no hit (and is saturated).
   std::uint8_t f = kFreeForAll | kSaturated;
@@ -322,6 +329,14 @@ void DpSlamMap::refreshFree(int tile, int cell) {
     root = root || c.entries[j].owner == root_;
   }
   t.free[cell] = root ? f : 0;
+  if (!t.free[cell]) return;
+  // The block's bits: those all its cells share (its rows are kBlockCells bytes apart by kTileSize).
+  const int first = (cell & ~(kTileSize * (kBlockCells - 1) + kBlockCells - 1));
+  std::uint8_t all = kFreeForAll | kSaturated;
+  for (int y = 0; y < kBlockCells && all; ++y) {
+    for (int x = 0; x < kBlockCells; ++x) all &= t.free[first + y * kTileSize + x];
+  }
+  t.block_free[b] = all;
 }
 
 void DpSlamMap::removeFromCell(int tile, int cell, int slot) {
@@ -738,16 +753,18 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
   const double near_end = hit ? length - 2.0 * resolution_ : length;  // every beam writes its last two cells
   const double from = std::max(0.0, std::min(b.write_from, near_end));
   Cursor cur;
-  traceCells(b.ox, b.oy, b.dx, b.dy, from, length, resolution_, [&](int ix, int iy, double t0, double t1) {
+  traceCells(b.ox, b.oy, b.dx, b.dy, from, length, resolution_, [&](int ix, int iy, double t0, double t1) -> int {
     const bool end = hit && t1 >= length;
     int q = 0;  // the cell's normal, if it has statistics
     if ((normals || !end || only_unknown) && seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
-      if ((!end || only_unknown) && (cur.t->free[cell] & skip_flag)) return true;
+      if ((!end || only_unknown) && (cur.t->free[cell] & skip_flag)) {
+        return (cur.t->block_free[blockOf(cell)] & skip_flag) ? kTraceSkipBlock : kTraceNext;
+      }
       const MapEntry* v = resolve(cur, cell, slot, cache);
-      if (v && only_unknown) return true;
+      if (v && only_unknown) return kTraceNext;
       if (v) {
-        if (!end && (freeBits(*v) & kSaturated)) return true;
+        if (!end && (freeBits(*v) & kSaturated)) return kTraceNext;
         if (normals) q = v->normal;
       }
     }
@@ -769,7 +786,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
         w.offset = static_cast<std::uint8_t>(quantizeOffset(n.c[nq] * px + n.s[nq] * py));
       }
     }
-    return true;
+    return kTraceNext;
   });
 }
 
@@ -798,7 +815,7 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
         if (node == root_) {
           refreshFree(cur.tile, cell);
         } else {
-          cur.t->free[cell] &= freeBits(v);
+          lowerFree(*cur.t, cell, freeBits(v));
         }
         continue;
       }
@@ -839,23 +856,25 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
   double tau = 0.0, reach = 1.0, eval = 0.0;
   bool in_window = false;
   Cursor cur;
-  traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, t_end, resolution_, [&](int ix, int iy, double t0, double t1) {
+  traceCells(b.ox, b.oy, b.dx, b.dy, 0.0, t_end, resolution_, [&](int ix, int iy, double t0, double t1) -> int {
     double mu = mu_unknown;
     int q = 0, k = 0;
     if (seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
-      if (cur.t->free[cell] & kFreeForAll) return true;  // density 0 for every slot: adds nothing
+      if (cur.t->free[cell] & kFreeForAll) {  // density 0 for every slot: adds nothing
+        return (cur.t->block_free[blockOf(cell)] & kFreeForAll) ? kTraceSkipBlock : kTraceNext;
+      }
       if (const MapEntry* v = resolve(cur, cell, slot, cache)) {
         mu = v->density();
         if (normals) q = v->normal;
         if (offsets) k = v->offset;
       }
     }
-    if (mu == 0.0) return true;
+    if (mu == 0.0) return kTraceNext;
     double d = (t1 - t0) * chordFactor(q, b, std::abs(0.5 * (t0 + t1) - z) < surface);
     if (t1 < window_start) {
       tau += mu * d;
-      return true;
+      return kTraceNext;
     }
     if (!in_window) {
       reach = negExp(tau);
@@ -866,7 +885,7 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
     reach *= pass;
     const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
     if (std::abs(e) < m.window) eval += stop * negExp(e * e * inv_2s2);
-    return reach > 1e-9;  // nothing left to explain: stop tracing
+    return reach > 1e-9 ? kTraceNext : kTraceStop;  // nothing left to explain: stop tracing
   });
   if (!in_window) reach = negExp(tau);
   const double value = no_return ? eval + reach : (reach < 1.0 ? eval / (1.0 - reach) : 0.0);
@@ -882,12 +901,13 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
   double reach = 1.0, eval = 0.0;
   Cursor cur;
   traceCells(b.ox, b.oy, b.dx, b.dy, std::max(0.0, z - half_window), z + half_window, resolution_,
-             [&](int ix, int iy, double t0, double t1) {
+             [&](int ix, int iy, double t0, double t1) -> int {
                double mu = mu_unknown;
                int q = 0, k = 0;
                if (seek(cur, ix, iy, cache)) {
                  const int cell = cellInTile(ix, iy);
-                 if (cur.t->free[cell] & kFreeForAll) return true;  // density 0 for every slot
+                 // density 0 for every slot (no block skips: the window is a few cells long)
+                 if (cur.t->free[cell] & kFreeForAll) return kTraceNext;
                  if (const MapEntry* v = resolve(cur, cell, slot, cache)) {
                    mu = v->density();
                    if (cell_normal_min_cos_ > 0.0) {
@@ -896,14 +916,14 @@ double DpSlamMap::beamEndpointLogLikelihood(const MapBeam& b, double half_window
                    }
                  }
                }
-               if (mu == 0.0) return true;
+               if (mu == 0.0) return kTraceNext;
                const double d = (t1 - t0) * chordFactor(q, b, std::abs(0.5 * (t0 + t1) - z) < surface_depth_);
                const double pass = negExp(mu * d);
                const double stop = reach * (1.0 - pass);
                reach *= pass;
                const double e = stopPoint(ix, iy, q, k, b, t0, t1) - z;
                eval += stop * negExp(e * e * inv_2s2);
-               return reach > 1e-9;
+               return reach > 1e-9 ? kTraceNext : kTraceStop;
              });
   const double value = reach < 1.0 ? eval / (1.0 - reach) : 0.0;
   return value > 0.0 ? std::max(std::log(value), m.log_floor) : m.log_floor;
