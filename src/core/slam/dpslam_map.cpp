@@ -310,6 +310,7 @@ std::uint8_t DpSlamMap::freeBits(const MapEntry& e) const {
 }
 
 void DpSlamMap::lowerFree(Tile& t, int cell, std::uint8_t bits) {
+  if (!(t.free[cell] & ~bits)) return;  // nothing drops (most written cells have no bits)
   t.free[cell] &= bits;
   t.block_free[blockOf(cell)] &= t.free[cell];
 }
