@@ -272,7 +272,7 @@ struct MapSide {
       nodes.push_back(lineage[i]);
     }
     LookupCache writes;
-    writes.begin(tree, nodes);
+    writes.begin(tree, nodes, true);
     for (std::size_t k = 0; k < who.size(); ++k) map.applyWrites(plans[who[k]], static_cast<int>(k), nodes[k], writes);
   }
 };
@@ -324,6 +324,31 @@ TEST(DpSlamMap, FreeCellBitsChangeNoScoreAndNoWrite) {
     ASSERT_EQ(with.map.entryCount(), without.map.entryCount()) << "step " << step;
   }
   EXPECT_GT(compared, 0u);
+}
+
+// A cell every lineage but one has written is not free for that one: it sees the cell unknown. Particle 1
+// alone maps the room's middle row for a few scans; particle 0 (the first slot) sees none of it.
+TEST(DpSlamMap, CellsOneLineageNeverSawStayUnknownToIt) {
+  MapSide with(true), without(false);
+  std::vector<std::vector<MapBeam>> beams(1);
+  with.advanceAndWrite({0, 0}, 1, with.plan(beams, false));
+  without.advanceAndWrite({0, 0}, 1, without.plan(beams, false));
+  beams.assign(2, {});
+  for (int n = 0; n < 10; ++n) beams[1].push_back(OneLineage::alongX(0.05 + 0.002 * n, 1.0));
+  for (int step = 2; step < 8; ++step) {
+    with.advanceAndWrite({0, 1}, step, with.plan(beams, false));
+    without.advanceAndWrite({0, 1}, step, without.plan(beams, false));
+  }
+  with.plan(beams, false);  // begins the caches with the leaves
+  without.plan(beams, false);
+  const BeamModelConfig model;
+  const MapBeam b = OneLineage::alongX(0.06, 1.0);
+  for (int slot = 0; slot < 2; ++slot) {
+    EXPECT_EQ(with.map.beamLogLikelihood(b, 20.0, slot, with.cache, model),
+              without.map.beamLogLikelihood(b, 20.0, slot, without.cache, model)) << "slot " << slot;
+  }
+  EXPECT_NE(with.map.beamLogLikelihood(b, 20.0, 0, with.cache, model),
+            with.map.beamLogLikelihood(b, 20.0, 1, with.cache, model));
 }
 
 // Pruning and collapsing change who owns what, never what a surviving particle sees.

@@ -150,7 +150,10 @@ class LookupCache {
  public:
   LookupCache() = default;
   /// Starts an iteration: `slot_nodes[s]` is the ancestry node whose map slot s sees. Invalidates all rows.
-  void begin(const AncestryTree& tree, const std::vector<int>& slot_nodes);
+  /// `every_particle`: every particle descends from one of the slot nodes (the writers' nodes, as DpSlam
+  /// begins the cache it passes to applyWrites), so that a cell in which each slot sees an entry is seen by
+  /// every particle (DpSlamMap's kCovered).
+  void begin(const AncestryTree& tree, const std::vector<int>& slot_nodes, bool every_particle = false);
   std::size_t slots() const { return slot_nodes_.size(); }
   std::size_t rowsBuilt() const { return rows_.size() / (slot_nodes_.empty() ? 1 : slot_nodes_.size()); }
   std::size_t memoryBytes() const;
@@ -175,6 +178,11 @@ class LookupCache {
   /// slots() values per row: entry index or -1. A cell holds one entry per node ID at most, so an
   /// index fits 16 bits (DpSlamMap::kMaxNodeId); the rows are most of a cache's memory.
   std::vector<std::int16_t> rows_;
+  /// While applyWrites runs (record_covered_): the (tile, cell) of rows built in which every slot sees an
+  /// entry, for DpSlamMap::kCovered.
+  bool every_particle_ = false;
+  bool record_covered_ = false;
+  std::vector<std::pair<int, int>> covered_;
   std::vector<std::int16_t> scratch_;
   std::vector<std::int32_t> memo_;                 ///< by node ID, while building a row
   std::vector<std::uint32_t> memo_stamp_;
@@ -326,12 +334,17 @@ class DpSlamMap : public AncestryHooks {
     std::uint16_t size = 0;
     std::uint8_t cls = 0xFF;  ///< size class of the block (EntryPool::capacity); 0xFF = none
   };
-  /// Tile::free bits (setRoot): the cell holds a root entry, so that every slot sees one, and no entry has
-  /// a hit: its density is 0 for every slot ...
+  /// Tile::free bits (setRoot): every slot sees an entry in the cell (it holds a root entry, or kCovered)
+  /// and no entry has a hit: its density is 0 for every slot ...
   static constexpr std::uint8_t kFreeForAll = 1;
   /// ... and every entry has seen at least the free saturation distance (setFreeSaturation): no write
   /// changes what any slot sees.
   static constexpr std::uint8_t kSaturated = 2;
+  /// Every particle sees an entry in the cell, its own lineage's or an ancestor's, though the root has none
+  /// (a cell each lineage wrote since their last common ancestor). Found when applyWrites builds the cell's
+  /// row; it then stays true: a new leaf descends from a covered one, a merge moves an entry to the parent
+  /// of the same leaves, and a node loses its entries only when no leaf descends from it any more.
+  static constexpr std::uint8_t kCovered = 4;
   /// The bits may be clear where they could be set (a trace then looks the cell up): after a removal they
   /// are recomputed only in cells left with this many entries or fewer.
   static constexpr int kFreeRescanSize = 4;

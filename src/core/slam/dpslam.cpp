@@ -238,7 +238,7 @@ void DpSlam::planWrites(const std::vector<int>& who, const std::vector<Pose2D>& 
 }
 
 void DpSlam::applyWrites(const std::vector<int>& who, const std::vector<int>& nodes) {
-  update_cache_.begin(tree_, nodes);
+  update_cache_.begin(tree_, nodes, true);  // every particle descends from a writer's node
   for (std::size_t s = 0; s < who.size(); ++s) {
     auto& w = writes_[who[s]];
     map_.applyWrites(w, static_cast<int>(s), nodes[s], update_cache_);

@@ -116,8 +116,9 @@ class DpSlamMap::EntryPool {
 };
 
 // ---------------------------------------------------------------------------------------------------
-void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_nodes) {
+void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_nodes, bool every_particle) {
   slot_nodes_ = slot_nodes;
+  every_particle_ = every_particle;
   parent_.assign(tree.idCapacity(), -1);
   for (std::size_t i = 0; i < tree.idCapacity(); ++i) {
     if (tree.valid(static_cast<int>(i))) parent_[i] = tree.parent(static_cast<int>(i));
@@ -310,8 +311,9 @@ std::uint8_t DpSlamMap::freeBits(const MapEntry& e) const {
 }
 
 void DpSlamMap::lowerFree(Tile& t, int cell, std::uint8_t bits) {
-  if (!(t.free[cell] & ~bits)) return;  // nothing drops (most written cells have no bits)
-  t.free[cell] &= bits;
+  const std::uint8_t keep = bits | kCovered;
+  if (!(t.free[cell] & ~keep)) return;  // nothing drops (most written cells have no bits)
+  t.free[cell] &= keep;
   t.block_free[blockOf(cell)] &= t.free[cell];
 }
 
@@ -319,18 +321,19 @@ void DpSlamMap::refreshFree(int tile, int cell) {
   Tile& t = *tiles_[tile];
   const Cell& c = t.cells[cell];
   const int b = blockOf(cell);
-  t.free[cell] = 0;
+  const std::uint8_t covered = t.free[cell] & kCovered;
+  t.free[cell] = covered;
   t.block_free[b] = 0;
   if (root_ < 0) return;  // no root told: no bits, every trace looks every cell up
-  // Every slot sees some entry (the root's, at least) and whichever it sees has no hit (and is saturated).
+  // Every slot sees some entry (the root's, or kCovered) and whichever it sees has no hit (and is saturated).
   std::uint8_t f = kFreeForAll | kSaturated;
-  bool root = false;
+  bool seen = covered != 0;
   for (int j = 0; j < c.size && f; ++j) {
     f &= freeBits(c.entries[j]);
-    root = root || c.entries[j].owner == root_;
+    seen = seen || c.entries[j].owner == root_;
   }
-  t.free[cell] = root ? f : 0;
-  if (!t.free[cell]) return;
+  if (!seen || !f) return;
+  t.free[cell] |= f;
   // The block's bits: those all its cells share (its rows are kBlockCells bytes apart by kTileSize).
   const int first = (cell & ~(kTileSize * (kBlockCells - 1) + kBlockCells - 1));
   std::uint8_t all = kFreeForAll | kSaturated;
@@ -503,6 +506,11 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
   }
   bool uniform = true;
   for (std::size_t s = 1; s < slots && uniform; ++s) uniform = out[s] == out[0];
+  if (cache.record_covered_ && slots > 0) {
+    bool covered = true;
+    for (std::size_t s = 0; s < slots && covered; ++s) covered = out[s] >= 0;
+    if (covered) cache.covered_.emplace_back(tile, cell);
+  }
   LookupCache::TileRows& tr = *cache.tiles_[tile];
   tr.cells[cell].stamp = cache.stamp_;
   if (uniform && slots > 0) {
@@ -794,6 +802,10 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
 void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache) {
   requireNodeId(node);
   if (static_cast<int>(owned_.size()) <= node) owned_.resize(node + 1);
+  // With a cache begun for every particle, a row in which each slot sees an entry marks the cell kCovered
+  // (after the writes, which its bits then include).
+  cache.record_covered_ = root_ >= 0 && cache.every_particle_;
+  cache.covered_.clear();
   Cursor cur;
   for (const CellWrite& w : writes) {
     seek(cur, w.ix, w.iy, cache, true);
@@ -833,6 +845,13 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
     owned_[node].push_back({static_cast<std::uint32_t>(cur.tile), static_cast<std::uint16_t>(cell), static_cast<std::uint16_t>(s)});
     // Keep this slot's cached view in step (other slots cannot see the new entry: it is a leaf's).
     setRowSlot(cache, cur.tile, cell, slot, s);
+  }
+  cache.record_covered_ = false;
+  for (const auto& tc : cache.covered_) {
+    Tile& t = *tiles_[tc.first];
+    if (t.free[tc.second] & kCovered) continue;
+    t.free[tc.second] |= kCovered;
+    refreshFree(tc.first, tc.second);
   }
 }
 
