@@ -245,10 +245,11 @@ class DpSlamMap : public AncestryHooks {
   /// is not rewritten (its density is 0 either way; this saves a copy per particle of every free cell).
   /// 0 = always write. Set before the first write.
   void setFreeSaturation(double distance);
-  /// The ancestry tree's root, whose entries every lineage sees. A cell holding a root entry and no entry
-  /// with a hit is free for every particle: the traces skip its look-up (a byte per cell, beside the tile,
-  /// instead of the cell's entries: most of a beam's path is such cells). -1 = none. Set before the first
-  /// write; clear() forgets it.
+  /// The ancestry tree's root, whose entries every lineage sees. A cell holding a root entry (or one each
+  /// writing lineage sees an entry in, kCovered) and no entry with a hit is free for every particle: the
+  /// traces skip its look-up (a byte per cell, beside the tile, instead of the cell's entries: most of a
+  /// beam's path is such cells), and whole blocks of such cells at once. -1 = none (no bits, no skips). Set
+  /// before the first write; clear() forgets it.
   void setRoot(int node) { root_ = node; }
   /// MapEntry::offset: 0 = none, else k in 1..255 for (k − 128)/127 · 0.75 · resolution m.
   int quantizeOffset(double s) const;
