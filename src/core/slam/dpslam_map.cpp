@@ -161,6 +161,7 @@ std::size_t LookupCache::memoryBytes() const {
     if (t) b += sizeof(TileRows);
   }
   return b + (memo_.capacity() + memo_stamp_.capacity() + depth_.capacity()) * 4 + descendants_.capacity() * 8 +
+         covered_.capacity() * sizeof(covered_[0]) +
          (slot_nodes_.capacity() + parent_.capacity()) * sizeof(int);
 }
 
