@@ -178,10 +178,9 @@ class LookupCache {
   /// slots() values per row: entry index or -1. A cell holds one entry per node ID at most, so an
   /// index fits 16 bits (DpSlamMap::kMaxNodeId); the rows are most of a cache's memory.
   std::vector<std::int16_t> rows_;
-  /// While applyWrites runs (record_covered_): the (tile, cell) of rows built in which every slot sees an
-  /// entry, for DpSlamMap::kCovered.
-  bool every_particle_ = false;
-  bool record_covered_ = false;
+  bool every_particle_ = false;  ///< begin's every_particle
+  /// With every_particle_: the (tile, cell) of the rows built in which every slot sees an entry, until
+  /// applyWrites marks them DpSlamMap::kCovered.
   std::vector<std::pair<int, int>> covered_;
   std::vector<std::int16_t> scratch_;
   std::vector<std::int32_t> memo_;                 ///< by node ID, while building a row
@@ -359,7 +358,7 @@ class DpSlamMap : public AncestryHooks {
   struct Tile {
     int tx = 0, ty = 0;
     Cell cells[kTileSize * kTileSize];
-    std::uint8_t free[kTileSize * kTileSize] = {};  ///< kFreeForAll | kSaturated per cell, kept by refreshFree
+    std::uint8_t free[kTileSize * kTileSize] = {};  ///< kFreeForAll | kSaturated | kCovered per cell (refreshFree)
     /// The bits every cell of a block of the traces' size (kTraceBlockShift) has: a trace that needs
     /// neither kind of cell skips the block at once (traceCells' kTraceSkipBlock).
     std::uint8_t block_free[kBlocksPerTile] = {};

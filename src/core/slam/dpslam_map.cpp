@@ -119,6 +119,7 @@ class DpSlamMap::EntryPool {
 void LookupCache::begin(const AncestryTree& tree, const std::vector<int>& slot_nodes, bool every_particle) {
   slot_nodes_ = slot_nodes;
   every_particle_ = every_particle;
+  covered_.clear();
   parent_.assign(tree.idCapacity(), -1);
   for (std::size_t i = 0; i < tree.idCapacity(); ++i) {
     if (tree.valid(static_cast<int>(i))) parent_[i] = tree.parent(static_cast<int>(i));
@@ -507,7 +508,7 @@ void DpSlamMap::buildRow(int tile, int cell, LookupCache& cache) const {
   }
   bool uniform = true;
   for (std::size_t s = 1; s < slots && uniform; ++s) uniform = out[s] == out[0];
-  if (cache.record_covered_ && slots > 0) {
+  if (cache.every_particle_ && slots > 0) {
     bool covered = true;
     for (std::size_t s = 0; s < slots && covered; ++s) covered = out[s] >= 0;
     if (covered) cache.covered_.emplace_back(tile, cell);
@@ -803,10 +804,6 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
 void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int node, LookupCache& cache) {
   requireNodeId(node);
   if (static_cast<int>(owned_.size()) <= node) owned_.resize(node + 1);
-  // With a cache begun for every particle, a row in which each slot sees an entry marks the cell kCovered
-  // (after the writes, which its bits then include).
-  cache.record_covered_ = root_ >= 0 && cache.every_particle_;
-  cache.covered_.clear();
   Cursor cur;
   for (const CellWrite& w : writes) {
     seek(cur, w.ix, w.iy, cache, true);
@@ -847,13 +844,15 @@ void DpSlamMap::applyWrites(const std::vector<CellWrite>& writes, int slot, int 
     // Keep this slot's cached view in step (other slots cannot see the new entry: it is a leaf's).
     setRowSlot(cache, cur.tile, cell, slot, s);
   }
-  cache.record_covered_ = false;
+  // With a cache begun for every particle, a row built in which each slot sees an entry marks the cell
+  // kCovered (after the writes, which its bits then include). No root told: no bits at all.
   for (const auto& tc : cache.covered_) {
     Tile& t = *tiles_[tc.first];
-    if (t.free[tc.second] & kCovered) continue;
+    if (root_ < 0 || (t.free[tc.second] & kCovered)) continue;
     t.free[tc.second] |= kCovered;
     refreshFree(tc.first, tc.second);
   }
+  cache.covered_.clear();
 }
 
 void DpSlamMap::addBeam(const MapBeam& b, double max_range, int slot, int node, LookupCache& cache) {
