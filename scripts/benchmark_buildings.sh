@@ -6,7 +6,7 @@
 # (seed 1) and run through dpslam_offline; plans/loop_building (2 laps) stays as one regression case.
 # Two modes per case:
 #   laser   the laser-only path (path_laser.txt: constant speed through blank stretches, stops and speed
-#           changes only where something along the corridor is in view), no wheel odometry
+#           changes only where a surface facing along the travel is in view), no wheel odometry
 #   wheels  the wheel path (path_wheels.txt: also stops and speed changes inside blank stretches), with
 #           /wheel_odom passed to dpslam_offline --wheel-odom
 # Prints one row per run (case, family, metres, odometry ATE, drift %, SLAM ATE) and, per mode, the median /

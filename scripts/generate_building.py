@@ -13,9 +13,10 @@ by a random angle and shifted off any lattice. The family defaults to one of the
 
 The path is one lap of the ring (through the dead end, the hall, the cross corridors) and on around the
 first side(s) again, so that the SLAM can close the loop on a revisit. Two flavours:
-  path_laser.txt   stops, dwells and speed changes only where something along the corridor is in view
+  path_laser.txt   stops, dwells and speed changes only where a surface facing along the travel is in view
                    within the laser's 240 degrees, arriving and driving off (corners, junctions); a dead end
-                   is left before its end wall is out of view behind; constant speed through blank stretches
+                   is left where the corridor it opens into is in view ahead; constant speed through blank
+                   stretches
   path_wheels.txt  the same route, plus stops (2-8 s) and speed changes inside the blank stretches, which
                    only wheel odometry can measure
 "Blank": a point of the path from which no corner, door jamb, pillar or piece of furniture is within the
@@ -289,28 +290,75 @@ def heading(a, b):
     return math.atan2(b[1] - a[1], b[0] - a[0])
 
 
-def stop_in_view(pts, k, feats, seg_a, seg_b, rng_range):
-    """Whether the laser can observe the stop at waypoint k and the start from it: something in view in
-    the heading the robot arrives in, and in the heading it drives off in (it turns in place between)."""
+FACING_ANGLE = math.radians(60.0)  # a surface within 30 deg of square to the travel tells the motion along it
+FACING_MIN = 0.3                   # m of such surface: about ten URG-04LX returns at the range's end
+SAMPLE = 0.05                      # m between the points a wall is checked at
+
+
+def facing_in_view(p, heading, circles, seg_a, seg_b, rng_range, half_fov=math.radians(120.0)):
+    """Whether the laser at p, facing `heading`, sees something that fixes its position along that heading:
+    a pillar, or FACING_MIN of wall more than FACING_ANGLE off the heading, within range, within the field
+    of view and with a clear line of sight. A wall's end seen edge-on (the mouth of a corridor ahead, a door
+    jamb in a side wall) does not count: it is the end of a grazing run of returns, and neither a scan
+    match nor the odometry's blank test can place the robot along the corridor by it."""
+    for cx, cy, r in circles:
+        q = np.array([cx, cy])
+        if np.hypot(*(q - p)) - r <= rng_range and _within_fov(p, q, heading, half_fov) and _clear(p, q, seg_a, seg_b):
+            return True
+    d = seg_b - seg_a
+    length = np.hypot(d[:, 0], d[:, 1])
+    off = np.abs(np.arctan2(d[:, 1], d[:, 0]) - heading) % math.pi
+    facing = np.minimum(off, math.pi - off) > FACING_ANGLE
+    seen = 0.0
+    for i in np.nonzero(facing & (length > 1e-9))[0]:
+        n = max(1, int(math.ceil(length[i] / SAMPLE)))
+        for q in seg_a[i] + d[i] * ((np.arange(n) + 0.5) / n)[:, None]:
+            if np.hypot(*(q - p)) <= rng_range and _within_fov(p, q, heading, half_fov) and _clear(p, q, seg_a, seg_b):
+                seen += length[i] / n
+                if seen >= FACING_MIN:
+                    return True
+    return False
+
+
+def _within_fov(p, q, heading, half_fov):
+    bearing = math.atan2(q[1] - p[1], q[0] - p[0]) - heading
+    return abs(math.atan2(math.sin(bearing), math.cos(bearing))) <= half_fov
+
+
+def _clear(p, q, seg_a, seg_b):
+    """No wall between p and q (q itself may lie on one)."""
+    r = q - p
+    e = seg_b - seg_a
+    den = r[0] * e[:, 1] - r[1] * e[:, 0]
+    f = seg_a - p
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (f[:, 0] * e[:, 1] - f[:, 1] * e[:, 0]) / den
+        u = (f[:, 0] * r[1] - f[:, 1] * r[0]) / den
+    return not ((np.abs(den) > 1e-12) & (t > 1e-6) & (t < 1 - 1e-4) & (u >= 0) & (u <= 1)).any()
+
+
+def stop_in_view(pts, k, circles, seg_a, seg_b, rng_range):
+    """Whether the laser can observe the stop at waypoint k and the start from it: a surface facing along
+    the heading the robot arrives in, and along the heading it drives off in (it turns in place between)."""
     p = np.array(pts[k][:2])
-    if k > 0 and not in_view(p, feats, seg_a, seg_b, rng_range, heading(pts[k - 1], pts[k])):
+    if k > 0 and not facing_in_view(p, heading(pts[k - 1], pts[k]), circles, seg_a, seg_b, rng_range):
         return False
-    return k + 1 == len(pts) or in_view(p, feats, seg_a, seg_b, rng_range, heading(pts[k], pts[k + 1]))
+    return k + 1 == len(pts) or facing_in_view(p, heading(pts[k], pts[k + 1]), circles, seg_a, seg_b, rng_range)
 
 
-def turn_where_in_view(laser, feats, seg_a, seg_b, rng_range, step=0.25):
-    """The laser path's out-and-back legs (a dead end) turn round at the deepest point from which something
-    is in view both arriving and driving off: at the end of a dead end longer than the range the end wall
-    is behind the robot as it starts back, and that start is invisible to the laser."""
+def turn_where_in_view(laser, circles, seg_a, seg_b, rng_range, step=0.25):
+    """The laser path's out-and-back legs (a dead end) turn round at the deepest point from which a surface
+    facing along the travel is in view both arriving and driving off: at the end of a dead end longer than
+    the range the end wall is behind the robot as it starts back, and that start is invisible to the laser."""
     pts = list(laser)
     for k in range(1, len(pts) - 1):
         a, b = pts[k - 1], pts[k]
-        if math.dist(a[:2], pts[k + 1][:2]) > 1e-6 or stop_in_view(pts, k, feats, seg_a, seg_b, rng_range):
+        if math.dist(a[:2], pts[k + 1][:2]) > 1e-6 or stop_in_view(pts, k, circles, seg_a, seg_b, rng_range):
             continue
         length = math.dist(a[:2], b[:2])
         for s in np.arange(length - step, 0.0, -step):
             q = (a[0] + (b[0] - a[0]) * s / length, a[1] + (b[1] - a[1]) * s / length) + tuple(b[2:])
-            if stop_in_view(pts[:k] + [q] + pts[k + 1:], k, feats, seg_a, seg_b, rng_range):
+            if stop_in_view(pts[:k] + [q] + pts[k + 1:], k, circles, seg_a, seg_b, rng_range):
                 pts[k] = q
                 break
     return pts
@@ -335,7 +383,7 @@ def blank_intervals(a, b, feats, seg_a, seg_b, rng_range, step=0.25):
     return out
 
 
-def make_paths(rng, route, feats, seg_a, seg_b, rng_range):
+def make_paths(rng, route, feats, circles, seg_a, seg_b, rng_range):
     """The laser and wheel flavours of the route (lists of (x, y, pause, speed)) and the blank stretches."""
     laser, wheels, blanks = [], [], []
     route = [p for k, p in enumerate(route) if k == 0 or math.dist(p, route[k - 1]) > 1e-6]
@@ -356,10 +404,10 @@ def make_paths(rng, route, feats, seg_a, seg_b, rng_range):
             wheels.append((x, y, rng.uniform(2.0, 8.0), rng.choice(SPEEDS)))
     laser.append((route[-1][0], route[-1][1], 0.0, 0.0))
     wheels.append((route[-1][0], route[-1][1], 0.0, 0.0))
-    laser = turn_where_in_view(laser, feats, seg_a, seg_b, rng_range)
+    laser = turn_where_in_view(laser, circles, seg_a, seg_b, rng_range)
     # Check: the laser flavour stops and starts only where something is in view ahead.
     for k, (x, y, _, _) in enumerate(laser):
-        if not stop_in_view(laser, k, feats, seg_a, seg_b, rng_range):
+        if not stop_in_view(laser, k, circles, seg_a, seg_b, rng_range):
             raise RuntimeError("laser-flavour waypoint (%.2f, %.2f) is blank" % (x, y))
     return laser, wheels, blanks
 
@@ -401,7 +449,7 @@ def generate(seed, family, out_dir, rng_range):
     seg_a = np.array([s[0] for s in segs] + [e for p in b.polygons for e in p])
     seg_b = np.array([s[1] for s in segs] + [p[(i + 1) % len(p)] for p in b.polygons for i in range(len(p))])
     feats = visible_features(segs, b.circles, b.polygons)
-    laser, wheels, blanks = make_paths(rng, route, feats, seg_a, seg_b, rng_range)
+    laser, wheels, blanks = make_paths(rng, route, feats, b.circles, seg_a, seg_b, rng_range)
 
     # Turn the whole building by a random angle and shift it off any lattice.
     th, ox, oy = rng.uniform(0, 2 * math.pi), rng.uniform(-10, 10), rng.uniform(-10, 10)
