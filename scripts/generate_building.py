@@ -291,16 +291,20 @@ def heading(a, b):
 
 
 FACING_ANGLE = math.radians(60.0)  # a surface within 30 deg of square to the travel tells the motion along it
-FACING_MIN = 0.3                   # m of such surface: about ten URG-04LX returns at the range's end
+FACING_MIN = 0.5                   # m of such surface in one piece (see facing_in_view)
+LASER_X = 0.1                      # m, the laser ahead of the robot's centre (simulate_scans' default mount)
 SAMPLE = 0.05                      # m between the points a wall is checked at
 
 
 def facing_in_view(p, heading, circles, seg_a, seg_b, rng_range, half_fov=math.radians(120.0)):
-    """Whether the laser at p, facing `heading`, sees something that fixes its position along that heading:
-    a pillar, or FACING_MIN of wall more than FACING_ANGLE off the heading, within range, within the field
-    of view and with a clear line of sight. A wall's end seen edge-on (the mouth of a corridor ahead, a door
-    jamb in a side wall) does not count: it is the end of a grazing run of returns, and neither a scan
-    match nor the odometry's blank test can place the robot along the corridor by it."""
+    """Whether the laser on the robot at p, facing `heading`, sees something that fixes its position along
+    that heading: a pillar, or a piece of wall FACING_MIN long and more than FACING_ANGLE off the heading,
+    within range, within the field of view and with a clear line of sight. A piece that long leaves a
+    scan matcher a surface whose direction it can fit away from the piece's ends (where an occluding edge
+    or the field of view cuts it). A wall's end seen edge-on (the mouth of a corridor ahead, a door jamb in
+    a side wall) does not count: it ends a grazing run of returns, and neither a scan match nor the
+    odometry's blank test can place the robot along the corridor by it."""
+    p = np.asarray(p, dtype=float) + LASER_X * np.array([math.cos(heading), math.sin(heading)])
     for cx, cy, r in circles:
         q = np.array([cx, cy])
         if np.hypot(*(q - p)) - r <= rng_range and _within_fov(p, q, heading, half_fov) and _clear(p, q, seg_a, seg_b):
@@ -309,14 +313,14 @@ def facing_in_view(p, heading, circles, seg_a, seg_b, rng_range, half_fov=math.r
     length = np.hypot(d[:, 0], d[:, 1])
     off = np.abs(np.arctan2(d[:, 1], d[:, 0]) - heading) % math.pi
     facing = np.minimum(off, math.pi - off) > FACING_ANGLE
-    seen = 0.0
-    for i in np.nonzero(facing & (length > 1e-9))[0]:
+    for i in np.nonzero(facing & (length >= FACING_MIN))[0]:
         n = max(1, int(math.ceil(length[i] / SAMPLE)))
+        run = 0
         for q in seg_a[i] + d[i] * ((np.arange(n) + 0.5) / n)[:, None]:
-            if np.hypot(*(q - p)) <= rng_range and _within_fov(p, q, heading, half_fov) and _clear(p, q, seg_a, seg_b):
-                seen += length[i] / n
-                if seen >= FACING_MIN:
-                    return True
+            seen = np.hypot(*(q - p)) <= rng_range and _within_fov(p, q, heading, half_fov) and _clear(p, q, seg_a, seg_b)
+            run = run + 1 if seen else 0
+            if run * length[i] / n >= FACING_MIN:
+                return True
     return False
 
 
