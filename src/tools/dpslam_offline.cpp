@@ -275,7 +275,7 @@ class OfflineRun {
   std::FILE* memory_log_;
   const bool show_progress_;
   std::string slam_log_ = "stamp,ok,x,y,theta,sxx,syy,stt,neff,resampled,score_spread,revisit\n";
-  std::string match_log_ = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt,pxx,pyy,ptt,flow_beams,flow_speed,flow_applied\n";
+  std::string match_log_ = "stamp,ok,skip_reason,x,y,theta,dx,dy,dtheta,score,matched,degenerate,weak,de_gen,de_evals,newton,points,keyframe,ms,sxx,syy,stt,pxx,pyy,ptt,flow_beams,flow_speed,flow_applied,held,held_blank\n";
   LaserOdometry odometry_;
   // The offline refinement of the output path keeps a keyframe (its scan's points) every 0.2 m.
   const bool refine_;
@@ -466,14 +466,14 @@ void OfflineRun::findMount(const sensor_msgs::LaserScan& msg) {
 
 void OfflineRun::logMatch(const LaserScan& scan, const OdometryUpdate& u, double ms) {
   char line[512];
-  std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g,%.4g,%.4g,%.4g,%d,%.4f,%d\n",
+  std::snprintf(line, sizeof(line), "%.6f,%d,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.3f,%d,%d,%d,%d,%d,%d,%d,%.4f,%.3g,%.3g,%.3g,%.4g,%.4g,%.4g,%d,%.4f,%d,%d,%d\n",
                 scan.stamp, u.ok, toString(u.skip_reason), u.pose.x, u.pose.y, u.pose.theta, u.delta.x, u.delta.y,
                 u.delta.theta, u.match.score_per_point, u.match.matched_fraction, u.match.degenerate, u.match.weak,
                 u.match.de_generations, u.match.de_evaluations, u.match.newton_iterations, u.points_used,
                 u.new_keyframe, ms, u.delta_covariance(0, 0), u.delta_covariance(1, 1), u.delta_covariance(2, 2),
                 u.pose_covariance(0, 0), u.pose_covariance(1, 1), u.pose_covariance(2, 2),
                 u.range_flow.valid ? u.range_flow.beams : 0, u.range_flow.valid ? u.range_flow.speed : 0.0,
-                u.range_flow_applied ? 1 : 0);
+                u.range_flow_applied ? 1 : 0, u.velocity_held ? 1 : 0, u.velocity_held_blank ? 1 : 0);
   match_log_ += line;
 }
 
