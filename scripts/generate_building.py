@@ -264,6 +264,23 @@ def visible_features(segs, circles, polygons):
     return np.array(pts)
 
 
+def _within_fov(p, q, heading, half_fov):
+    bearing = math.atan2(q[1] - p[1], q[0] - p[0]) - heading
+    return abs(math.atan2(math.sin(bearing), math.cos(bearing))) <= half_fov
+
+
+def _clear(p, q, seg_a, seg_b):
+    """No wall between p and q (q itself may lie on one)."""
+    r = q - p
+    e = seg_b - seg_a
+    den = r[0] * e[:, 1] - r[1] * e[:, 0]
+    f = seg_a - p
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (f[:, 0] * e[:, 1] - f[:, 1] * e[:, 0]) / den
+        u = (f[:, 0] * r[1] - f[:, 1] * r[0]) / den
+    return not ((np.abs(den) > 1e-12) & (t > 1e-6) & (t < 1 - 1e-4) & (u >= 0) & (u <= 1)).any()
+
+
 def in_view(p, feats, seg_a, seg_b, rng_range, heading=None, half_fov=math.radians(120.0)):
     """Whether any feature lies within range of p with a clear line of sight and, given the robot's heading,
     within the laser's field of view (the URG-04LX's 240 degrees: a wall end behind the robot is not seen)."""
@@ -272,18 +289,7 @@ def in_view(p, feats, seg_a, seg_b, rng_range, heading=None, half_fov=math.radia
     if heading is not None:
         bearing = np.arctan2(feats[:, 1] - p[1], feats[:, 0] - p[0]) - heading
         near &= np.abs(np.arctan2(np.sin(bearing), np.cos(bearing))) <= half_fov
-    for q in feats[near]:
-        r = q - p
-        e = seg_b - seg_a
-        den = r[0] * e[:, 1] - r[1] * e[:, 0]
-        f = seg_a - p
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = (f[:, 0] * e[:, 1] - f[:, 1] * e[:, 0]) / den
-            u = (f[:, 0] * r[1] - f[:, 1] * r[0]) / den
-        blocked = (np.abs(den) > 1e-12) & (t > 1e-6) & (t < 1 - 1e-4) & (u >= 0) & (u <= 1)
-        if not blocked.any():
-            return True
-    return False
+    return any(_clear(p, q, seg_a, seg_b) for q in feats[near])
 
 
 def heading(a, b):
@@ -322,23 +328,6 @@ def facing_in_view(p, heading, circles, seg_a, seg_b, rng_range, half_fov=math.r
             if run * length[i] / n >= FACING_MIN:
                 return True
     return False
-
-
-def _within_fov(p, q, heading, half_fov):
-    bearing = math.atan2(q[1] - p[1], q[0] - p[0]) - heading
-    return abs(math.atan2(math.sin(bearing), math.cos(bearing))) <= half_fov
-
-
-def _clear(p, q, seg_a, seg_b):
-    """No wall between p and q (q itself may lie on one)."""
-    r = q - p
-    e = seg_b - seg_a
-    den = r[0] * e[:, 1] - r[1] * e[:, 0]
-    f = seg_a - p
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (f[:, 0] * e[:, 1] - f[:, 1] * e[:, 0]) / den
-        u = (f[:, 0] * r[1] - f[:, 1] * r[0]) / den
-    return not ((np.abs(den) > 1e-12) & (t > 1e-6) & (t < 1 - 1e-4) & (u >= 0) & (u <= 1)).any()
 
 
 def stop_in_view(pts, k, circles, seg_a, seg_b, rng_range):
