@@ -398,7 +398,7 @@ def make_paths(rng, route, feats, circles, seg_a, seg_b, rng_range):
     laser.append((route[-1][0], route[-1][1], 0.0, 0.0))
     wheels.append((route[-1][0], route[-1][1], 0.0, 0.0))
     laser = turn_where_in_view(laser, circles, seg_a, seg_b, rng_range)
-    # Check: the laser flavour stops and starts only where something is in view ahead.
+    # Check: the laser flavour stops and starts only where a surface facing along the travel is in view.
     for k, (x, y, _, _) in enumerate(laser):
         if not stop_in_view(laser, k, circles, seg_a, seg_b, rng_range):
             raise RuntimeError("laser-flavour waypoint (%.2f, %.2f) is blank" % (x, y))
