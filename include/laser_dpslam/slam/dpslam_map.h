@@ -363,6 +363,11 @@ class DpSlamMap : public AncestryHooks {
     /// neither kind of cell skips the block at once (traceCells' kTraceSkipBlock).
     std::uint8_t block_free[kBlocksPerTile] = {};
   };
+  /// A trace's step past a cell whose free bits hold `flag`: the rest of its block too when every cell of the
+  /// block holds it (traceCells' kTraceSkipBlock), else the next cell.
+  static int passFree(const Tile& t, int cell, std::uint8_t flag) {
+    return (t.block_free[blockOf(cell)] & flag) ? kTraceSkipBlock : kTraceNext;
+  }
   /// A cell's Tile::free bits can only drop to `bits` (an entry appended or changed): its block's with them.
   static void lowerFree(Tile& t, int cell, std::uint8_t bits);
   struct EntryRef {

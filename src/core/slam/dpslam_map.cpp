@@ -769,9 +769,7 @@ void DpSlamMap::planBeam(const MapBeam& b, double max_range, int slot, LookupCac
     int q = 0;  // the cell's normal, if it has statistics
     if ((normals || !end || only_unknown) && seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
-      if ((!end || only_unknown) && (cur.t->free[cell] & skip_flag)) {
-        return (cur.t->block_free[blockOf(cell)] & skip_flag) ? kTraceSkipBlock : kTraceNext;
-      }
+      if ((!end || only_unknown) && (cur.t->free[cell] & skip_flag)) return passFree(*cur.t, cell, skip_flag);
       const MapEntry* v = resolve(cur, cell, slot, cache);
       if (v && only_unknown) return kTraceNext;
       if (v) {
@@ -881,9 +879,8 @@ double DpSlamMap::beamLogLikelihood(const MapBeam& b, double max_range, int slot
     int q = 0, k = 0;
     if (seek(cur, ix, iy, cache)) {
       const int cell = cellInTile(ix, iy);
-      if (cur.t->free[cell] & kFreeForAll) {  // density 0 for every slot: adds nothing
-        return (cur.t->block_free[blockOf(cell)] & kFreeForAll) ? kTraceSkipBlock : kTraceNext;
-      }
+      // density 0 for every slot: adds nothing
+      if (cur.t->free[cell] & kFreeForAll) return passFree(*cur.t, cell, kFreeForAll);
       if (const MapEntry* v = resolve(cur, cell, slot, cache)) {
         mu = v->density();
         if (normals) q = v->normal;
