@@ -265,8 +265,10 @@ def visible_features(segs, circles, polygons):
 
 
 def _within_fov(p, q, heading, half_fov):
-    bearing = math.atan2(q[1] - p[1], q[0] - p[0]) - heading
-    return abs(math.atan2(math.sin(bearing), math.cos(bearing))) <= half_fov
+    """Whether the point q (or each row of an array of points) lies within half_fov of the heading from p."""
+    q = np.asarray(q)
+    bearing = np.arctan2(q[..., 1] - p[1], q[..., 0] - p[0]) - heading
+    return np.abs(np.arctan2(np.sin(bearing), np.cos(bearing))) <= half_fov
 
 
 def _clear(p, q, seg_a, seg_b):
@@ -287,8 +289,7 @@ def in_view(p, feats, seg_a, seg_b, rng_range, heading=None, half_fov=math.radia
     d = np.hypot(feats[:, 0] - p[0], feats[:, 1] - p[1])
     near = d <= rng_range
     if heading is not None:
-        bearing = np.arctan2(feats[:, 1] - p[1], feats[:, 0] - p[0]) - heading
-        near &= np.abs(np.arctan2(np.sin(bearing), np.cos(bearing))) <= half_fov
+        near &= _within_fov(p, feats, heading, half_fov)
     return any(_clear(p, q, seg_a, seg_b) for q in feats[near])
 
 
