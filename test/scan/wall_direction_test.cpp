@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -42,6 +43,30 @@ TEST(WallDirection, FindsTheWallsOfATurnedRoomModulo90Degrees) {
     EXPECT_GT(w.strength, 0.6) << deg;
     EXPECT_GT(w.chords, 200) << deg;
   }
+}
+
+TEST(WallDirection, TheProjectionsSharpenACoarseAngleToATenthOfADegree) {
+  // 20 noisy scans of the room at angles off the 0.01° search steps, refined from a start 2.5° off: the
+  // error of the grid a map is then aligned with (a 1° error bends a 30 m corridor by 0.5 m).
+  double worst = 0.0, squares = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    const double deg = -40.0 + 4.237 * k;
+    const double turn = deg * M_PI / 180.0;
+    const double got = refineWallAngle(scanRoom(turn, 10 + k), turn + (k % 2 ? 2.5 : -2.5) * M_PI / 180.0);
+    const double error = (got - turn) * 180.0 / M_PI;
+    worst = std::max(worst, std::abs(error));
+    squares += error * error;
+  }
+  // This room's noise (1 cm + 1 %) is more than a URG-04LX's: RMS 0.08°, worst 0.18° (the chords alone:
+  // 0.1–1.4°).
+  EXPECT_LT(std::sqrt(squares / 20.0), 0.1);
+  EXPECT_LT(worst, 0.25);
+  // Out of its ±3° window it cannot reach the walls: it stays at the window's edge.
+  const double far = refineWallAngle(scanRoom(0.0, 1), 5.0 * M_PI / 180.0);
+  EXPECT_NEAR(far * 180.0 / M_PI, 2.0, 0.011);
+  // Nothing to refine: the coarse angle back; non-finite and far points are ignored.
+  EXPECT_EQ(refineWallAngle({}, 0.3), 0.3);
+  EXPECT_EQ(refineWallAngle({{1.0, 0.0}, {1e9, 0.0}, {NAN, 1.0}}, 0.3), 0.3);
 }
 
 TEST(WallDirection, NoDirectionOnACircleAndNothingWithoutChords) {

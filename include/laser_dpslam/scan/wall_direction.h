@@ -21,8 +21,18 @@ struct WallDirection {
 /// off it (a corner). Short chords carry the range noise (URG-04LX: 1 % of the
 /// range, so ±0.6 rad per 0.1 m chord at 4 m), hence chords that grow with the range. Each chord votes with
 /// its angle times 4 (so directions 90° apart agree) on the unit circle; the angle of the mean resultant over
-/// 4 is the dominant direction. angle 0, strength 0 when there is no chord.
+/// 4 is the dominant direction: on one URG-04LX scan within ~1.2° of the walls (refineWallAngle sharpens it
+/// to ~0.1°). angle 0, strength 0 when there is no chord.
 WallDirection dominantWallDirection(const std::vector<Eigen::Vector2d>& ordered_points, double min_chord = 0.1,
                                     double chord_per_metre = 0.1);
+
+/// The angle within ±3° of `coarse` at which the points' projections on the two axes it defines pile up most
+/// sharply: Σ h² of histograms (1 cm bins, linear binning) of the points' coordinates along and across it,
+/// searched in 0.01° steps. A wall's points then share one bin across it; a frame turned by δ spreads a wall
+/// of length l over l·δ. Uses every return of every straight wall, not chords between neighbours, whose
+/// angles carry the range noise (one scan, 60 generated buildings: 0.04° median and 0.15° worst error,
+/// against 0.36° and 1.14° for the chords' vote). Non-finite points and points beyond 30 m are left out;
+/// fewer than two points: `coarse`.
+double refineWallAngle(const std::vector<Eigen::Vector2d>& points, double coarse);
 
 }  // namespace laser_dpslam

@@ -275,11 +275,15 @@ DpSlamUpdate DpSlam::process(double stamp, const PreprocessedScan& scan, const L
     }
     makeBeams(scan, mount);
     const int P = config_.particles;
-    // The first pose defines the map frame; turned by the walls' angle, the grid's rows run along them.
+    // The first pose defines the map frame; turned by the walls' angle, the grid's rows run along them. The
+    // angle must be good to a tenth of a degree, not the chords' ~1°: the particles' headings drift toward
+    // the grid's axes, and a 1° pull bends a 30 m corridor by 0.5 m (doc/experiments.md, "The map's grid
+    // turned to the walls by the projections").
     Pose2D first;
     if (config_.map_align_to_walls) {
-      const WallDirection w = dominantWallDirection(mount.apply(scan.points));
-      if (w.strength >= config_.map_wall_min_strength) first = Pose2D(0.0, 0.0, -w.angle);
+      const std::vector<Eigen::Vector2d> points = mount.apply(scan.points);
+      const WallDirection w = dominantWallDirection(points);
+      if (w.strength >= config_.map_wall_min_strength) first = Pose2D(0.0, 0.0, -refineWallAngle(points, w.angle));
     }
     const int root = tree_.createRoot(0);
     map_.setRoot(root);

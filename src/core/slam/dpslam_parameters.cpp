@@ -96,9 +96,10 @@ std::vector<Parameter<S>> mapEntries() {
       {"map_resolution", "map", FIELD(slam.map_resolution), "m", above(0), "cell size (the original used 0.0286)",
        kUser},
       {"align_to_walls", "map", FIELD(slam.map_align_to_walls), "bool", anyValue(),
-       "the map frame's axes run along the first scan's dominant wall direction (modulo 90 deg, as the odometry's "
-       "align_to_walls finds it) instead of the first heading: the map comes out square to the building; the first "
-       "pose is then (0, 0, -that angle). The same key as the odometry's: one choice for the building",
+       "the map frame's axes run along the first scan's dominant wall direction (modulo 90 deg; the odometry's "
+       "estimate, sharpened to about 0.1 deg by the points' projections) instead of the first heading: the map "
+       "comes out square to the building; the first pose is then (0, 0, -that angle). The same key as the "
+       "odometry's: one choice for the building",
        kUser},
       {"no_return_range", "map", FIELD(slam.no_return_range), "m", above(0),
        "a no-return beam (+inf) is free space up to min(this, the scan's range_max)", kUser},
