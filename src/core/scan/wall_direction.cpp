@@ -13,8 +13,8 @@ constexpr double kRefineStep = 0.01 * M_PI / 180.0;
 // Histogram bin of the projections: about the range noise of near returns (URG-04LX: 1 cm). Coarser bins
 // blur the peaks of the walls (5 cm: median error 0.16°), finer ones gain nothing.
 constexpr double kProjectionBin = 0.01;
-// Returns farther than this are left out of the refinement: they add noise more than sharpness, and the
-// histograms stay small (any range_max, a stray far point).
+// Returns farther than this are left out of the refinement: far returns are sparse and their range noise large,
+// and the histograms stay small whatever the range_max (a stray far point would size them).
 constexpr double kRefineMaxRange = 30.0;
 
 // Σ h² of a histogram of v (linear binning, so that the sum moves smoothly with v): the more points share a
