@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
+#include <string>
 
 #include "laser_dpslam/odometry/wheel_motion.h"
 #include "laser_dpslam/sim/scan_simulator.h"
@@ -227,35 +229,55 @@ TEST(LaserOdometry, VelocityIsTheSmoothedMatchedMotion) {
   EXPECT_GT(checked, static_cast<int>(run.scans.size()) / 2);
 }
 
-// The loop building's west corridor (westCorridorFinalError), from rest at its north end to its south end.
-// Where the match is degenerate its motion along the corridor is the prior plus the NDT score's ripple (the
-// score of points on a wall varies with their place in the cells); smoothing that into the velocity with the
-// full gain lets the estimate stall for seconds. degenerate_velocity_gain (0.1 for lasers up to 10 m) averages it over more scans. Without the hold, the
-// flow and the prior release, the final errors of seeds 1-6 sum to 0.451 m without the gain and 0.376 m with it
-// (−17 %; a scan's ripple is not a constant bias, so single seeds may lose: the sum is what it shrinks). With
-// the defaults' hold the gain changes nothing on this corridor; it still helps the demo bag's and the whole
-// loop's odometry (doc/experiments.md), but it costs CSAIL (doc/tuning.md).
-TEST(LaserOdometry, DegenerateVelocityGainShrinksTheCorridorStall) {
-  LaserOdometryConfig without, with_gain;
-  without.degenerate_velocity_gain = -1.0;
-  without.prior_release_speed = 0.0;  // measured before it (its own test below)
-  with_gain.degenerate_velocity_gain = 0.1;
-  with_gain.prior_release_speed = 0.0;
-  without.degenerate_hold_time = with_gain.degenerate_hold_time = 0.0;  // measured before it (its own test below)
-  without.range_flow_gain = with_gain.range_flow_gain = 0.0;            // likewise
-  double e_without = 0.0, e_gain = 0.0;
-  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
-    e_without += westCorridorFinalError(without, seed);
-    e_gain += westCorridorFinalError(with_gain, seed);
-  }
-  EXPECT_LT(e_gain, 0.9 * e_without);
+// degenerate_velocity_gain: where the match is degenerate, its motion along the weak direction is the prior
+// plus the NDT score's ripple (the score of points on a wall varies with their place in the cells), and the
+// velocity along that direction takes only that gain of it (v_w ← v_w + g_w·(Δ_w/dt − v_w)), across it
+// velocity_gain as everywhere. Its effect is a distribution's, not one corridor's: on the generated buildings
+// (scripts/benchmark_buildings.sh --odometry-only, both lists, search seeds 1 and 2) switching it off changes
+// 3-4 of ~30 runs per list and seed, among them the loop building, whose odometry ATE goes 0.042 / 0.094 m →
+// 0.123 / 0.204 m (a heading error of up to 0.9° builds up); with the defaults' hold it changes nothing on
+// the west corridor (doc/experiments.md, "The held speed fitted to the matches that measured it"). Here: the
+// rule itself on that corridor, from rest at its north end to its south end, without the hold, the flow and
+// the release (which move the velocity by their own rules).
+TEST(LaserOdometry, DegenerateVelocityGainSmoothsAlongTheWeakDirection) {
+  LaserOdometryConfig c;
+  c.align_to_walls = false;  // the updates' poses in the frame the matches are made in
+  c.degenerate_hold_time = 0.0;
+  c.range_flow_gain = 0.0;
+  c.prior_release_speed = 0.0;
+  const double g = c.velocity_gain, gw = c.degenerate_velocity_gain;
+  ASSERT_GT(gw, 0.0);
+  ASSERT_LT(gw, g);
+  static const std::vector<TimedPose> truth = samplePath({{1.95, 19.05}, {1.95, 1.95}}, 10.0, PathConfig());
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  Pose2D previous;
+  double last_stamp = 0.0;
+  int checked = 0;
+  bool was_blank = false;
+  loopBuildingFinalError(truth, c, 1, [&](const TimedPose&, const OdometryUpdate& u) {
+    // (A blank stretch's first scan sets the speed it holds by its own rule: HeldSpeedCarriesAFortyMetre….)
+    const bool fitted = u.velocity_held_blank && !was_blank;
+    was_blank = u.velocity_held_blank;
+    if (u.ok && !u.reset && u.match.degenerate && !fitted) {
+      const Eigen::Vector2d w = previous.rotation().transpose() * u.match.weak_direction;  // base frame
+      const Eigen::Vector2d measured = Eigen::Vector2d(u.delta.x, u.delta.y) / (u.stamp - last_stamp);
+      const Eigen::Vector2d across(-w.y(), w.x());
+      EXPECT_NEAR(w.dot(u.velocity.head<2>()), w.dot(v.head<2>()) + gw * w.dot(measured - v.head<2>()), 1e-9);
+      EXPECT_NEAR(across.dot(u.velocity.head<2>()), across.dot((1.0 - g) * v.head<2>() + g * measured), 1e-9);
+      ++checked;
+    }
+    v = u.velocity;
+    previous = u.pose;
+    last_stamp = u.stamp;
+  });
+  EXPECT_GT(checked, static_cast<int>(truth.size()) / 4);
+  RecordProperty("degenerate_scans", checked);
   // Only for short-range lasers: with a laser longer than degenerate_velocity_max_range the gain is not used
   // (nor the blank-stretch hold, which the same range gates: both configs are gated here).
-  LaserOdometryConfig gated = with_gain, gated_without = without;
+  LaserOdometryConfig gated = c, gated_without = c;
+  gated_without.degenerate_velocity_gain = -1.0;
   gated.degenerate_velocity_max_range = gated_without.degenerate_velocity_max_range = 5.0;  // the URG-04LX: 5.6 m
   EXPECT_EQ(westCorridorFinalError(gated, 1), westCorridorFinalError(gated_without, 1));
-  RecordProperty("without_gain_mean_mm", static_cast<int>(1000.0 * e_without / 6.0));
-  RecordProperty("with_gain_mean_mm", static_cast<int>(1000.0 * e_gain / 6.0));
 }
 
 // The same corridor with the hold: south of the niche nothing along the corridor is in range for 3-6 s, and
@@ -482,7 +504,54 @@ const FloorPlan& blankCorridor() {
   return plan;
 }
 
+// A corridor 2.5 m wide and 72 m long, closed at both ends, with boxes on both walls every 1.5 m over its
+// first and last 10 m: a robot driving its middle passes the first boxes at cruise speed, and between
+// x ≈ 15.6 and 56.4 m nothing that faces along the corridor is within the URG-04LX's 5.6 m ahead.
+const FloorPlan& longBlankCorridor() {
+  static const FloorPlan plan = [] {
+    std::vector<test::Box> boxes{{0.0, 0.0, 72.0, 0.1}, {0.0, 2.4, 72.0, 2.5}, {0.0, 0.0, 0.1, 2.5}, {71.9, 0.0, 72.0, 2.5}};
+    for (double x = 1.0; x <= 10.0; x += 1.5) {
+      boxes.push_back({x, 0.1, x + 0.3, 0.5});
+      boxes.push_back({x + 0.7, 2.0, x + 1.0, 2.4});
+    }
+    for (double x = 62.0; x <= 70.0; x += 1.5) {
+      boxes.push_back({x, 0.1, x + 0.3, 0.5});
+      boxes.push_back({x + 0.7, 2.0, x + 1.0, 2.4});
+    }
+    return test::planFromBoxes(72.0, 2.5, 0.05, boxes);
+  }();
+  return plan;
+}
+
 }  // namespace
+
+// A 40.8 m blank corridor at 0.3 m/s, laser only, entered at speed: the along-track error gained between
+// x = 15.6 and 56.4 m stays within 1 % of that length, and the pose's 3σ covers the error at every scan.
+// Three placements of the path a few millimetres apart and two simulator seeds: which matches come out
+// degenerate near the stretch's ends depends on both, and one placement alone passes or fails by its luck
+// (doc/experiments.md, "The held speed fitted to the matches that measured it").
+TEST(LaserOdometry, HeldSpeedCarriesAFortyMetreBlankCorridorWithinOnePercent) {
+  for (const double shift : {0.0, 0.013, 0.031}) {
+    const std::vector<TimedPose> truth =
+        samplePath({{3.0 + shift, 1.25 + shift}, {69.0 + shift, 1.25 + shift}}, 10.0, PathConfig());
+    for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+      double enter = std::numeric_limits<double>::quiet_NaN(), leave = enter;
+      int uncovered = 0;
+      runWithWheels(longBlankCorridor(), truth, 0.0, seed, [&](const TimedPose& tp, const OdometryUpdate& u) {
+        const double error = u.pose.x - (tp.pose.x - truth.front().pose.x);
+        if (std::isnan(enter) && tp.pose.x >= 15.6 + shift) enter = error;
+        if (std::isnan(leave) && tp.pose.x >= 56.4 + shift) leave = error;
+        uncovered += std::abs(error) <= 3.0 * std::sqrt(u.pose_covariance(0, 0)) ? 0 : 1;
+      });
+      const std::string at = "shift " + std::to_string(shift) + " seed " + std::to_string(seed);
+      EXPECT_LE(std::abs(leave - enter), 0.01 * 40.8) << at;
+      EXPECT_EQ(uncovered, 0) << at;
+      RecordProperty("shift" + std::to_string(static_cast<int>(1000 * shift)) + "_seed" + std::to_string(seed) +
+                         "_blank_drift_mm",
+                     static_cast<int>(1000.0 * std::abs(leave - enter)));
+    }
+  }
+}
 
 // Where the scan constrains the motion the laser decides: wheels reporting 10 % more distance than was
 // driven move the final estimate of the furnished-room loop (every scan constrained) by under 1 % of the
@@ -552,16 +621,17 @@ TEST(LaserOdometry, SkipReasonsPrintAsTheirLogWords) {
   EXPECT_EQ(OdometryUpdate().skip_reason, OdometrySkipReason::kNone);
 }
 
-// Laser only, at a constant 0.3 m/s through the blank corridor (32 m of it with nothing along it in range):
-// the velocity measured where the boxes fix the position is kept for as long as nothing contradicts it
-// (degenerate_hold_time), so the estimate keeps moving: worst along-track error 0.88 / 1.86 m (seeds 1 / 2)
-// where a 10 s hold ended 31-34 m behind. Still short of 1 % of the corridor: the held velocity is the one
-// smoothed over the first metre (0.308 m/s for 0.300), and each degenerate match pulls the position back
-// towards the local map by about a millimetre (doc/experiments.md, "The corridor hold without a time limit",
-// "Where the NDT pulls back along a blank corridor").
+// Laser only, from rest 1 m before the blank corridor (32 m of it with nothing along it in range) and then
+// at a constant 0.3 m/s: the velocity of the first metre is kept for as long as nothing contradicts it, so the
+// estimate keeps moving: worst along-track error 0.64 / 0.24 m (seeds 1 / 2) where a 10 s hold ended 31-34 m
+// behind. The robot reaches its speed within the first 0.1 m, but the boxes there are seen obliquely and the
+// matches turn degenerate while the smoothed velocity still lags the acceleration (0.21-0.22 m/s for 0.30 where traced): no
+// constant-speed window of constrained matches is there to fit, and a path a few millimetres to the side
+// ends metres off (doc/experiments.md, "The held speed fitted to the matches that measured it"). The
+// corridor entered at speed is HeldSpeedCarriesAFortyMetreBlankCorridorWithinOnePercent.
 // The published pose covariance along the corridor grows with the time held, as a held velocity's error
-// does (σ 1.44 / 1.48 m at the end, seeds 1 / 2), and its 3σ covers the along-track error at every held scan. (Not
-// at every scan: during the start from rest, before the hold, seed 1 is 2.9 cm off at t = 0.7 s with σ 8 mm.)
+// does (σ 1.49 / 1.47 m at the end, seeds 1 / 2), and its 3σ covers the along-track error at every held scan
+// here (not at every scan: during the start from rest, before the hold, the error exceeds 3σ at one scan).
 TEST(LaserOdometry, HoldKeepsTheLaserOnlyEstimateMovingThroughABlankCorridor) {
   const std::vector<TimedPose> truth = samplePath({{3.0, 1.25}, {47.0, 1.25}}, 10.0, PathConfig());
   for (std::uint64_t seed = 1; seed <= 2; ++seed) {

@@ -108,9 +108,14 @@ class ScanMatcher {
   /// `allow_prior_release`: a degenerate match may drop that prior (ScanMatcherConfig::prior_release_margin).
   /// `hold_prior_when_degenerate`: along a degenerate direction keep the prior exactly (the prior is a
   /// measurement there: wheel odometry, or a blank stretch of corridor).
+  /// `unconstrained` (non-zero, with the hold): a translation direction the caller knows the scan does not
+  /// measure (a blank stretch: nothing along it in view). The prior is kept along it and the match is
+  /// reported degenerate along it even where the Hessian's ratio test passes: a few far returns at grazing
+  /// incidence give the score a curvature there that is noise, not a measurement.
   MatchResult match(const std::vector<Eigen::Vector2d>& search_points, const std::vector<Eigen::Vector2d>& polish_points,
                     const Pose2D& prior, std::mt19937_64& rng, double prior_sigma_xy = 0.0,
-                    bool allow_prior_release = false, bool hold_prior_when_degenerate = false) const;
+                    bool allow_prior_release = false, bool hold_prior_when_degenerate = false,
+                    const Eigen::Vector2d& unconstrained = Eigen::Vector2d::Zero()) const;
 
   /// Newton polish only, from `start`, on resolution level `level` (exposed for tests). With `basis`
   /// (3×k, orthonormal columns) the steps stay in the subspace it spans. `final_score`: the level's NDT
@@ -139,6 +144,7 @@ class ScanMatcher {
     const Pose2D& prior;
     double prior_sigma_xy;
     double n;  ///< polish_points.size()
+    Eigen::Vector2d unconstrained;  ///< unit direction the scan is known not to measure, or zero
   };
   /// DE over ±w around the prior on the raster, the prior seeded into the population; counts into r.
   Pose2D deSearch(const MatchInput& in, const Eigen::Vector3d& w, std::mt19937_64& rng, MatchResult& r) const;
@@ -155,7 +161,8 @@ class ScanMatcher {
   /// The polish without the prior replaces *pose when it scores clearly better far enough along `weak`.
   void releasePrior(const MatchInput& in, const Eigen::Vector2d& weak, double prior_sigma, Pose2D* pose, NdtScore* s,
                     MatchResult& r) const;
-  Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& result) const;
+  Eigen::Matrix3d covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, const Eigen::Vector2d& unconstrained,
+                                 MatchResult& result) const;
   /// True when H's translation block has a direction the scan barely constrains (degeneracy_ratio); that
   /// direction (unit) into *weak.
   bool degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* weak) const;

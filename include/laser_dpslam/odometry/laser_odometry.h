@@ -181,7 +181,7 @@ class LaserOdometry {
   bool blankAlongCorridor(const std::vector<Eigen::Vector2d>& base_points, const Pose2D& prior) const;
   /// Cuts a degenerate match's step along its weak direction to kDegenerateStepSigmas · prior_sigma from the prior.
   static void limitDegenerateStep(const Pose2D& prior, double prior_sigma, MatchResult& m);
-  /// Keeps the poses of matches outside blank stretches; at a blank stretch's first scan, the held speed.
+  /// Keeps the poses of constrained matches on the straight run; at a blank stretch's first scan, the held speed.
   void seeAlongCorridor(double stamp, const OdometryUpdate& u);
   void holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d& weak);
   /// The scan's match against the local map from `prior`, into u.match (and u.points_used).
@@ -221,12 +221,16 @@ class LaserOdometry {
   static constexpr double kMinFacingLength = 0.1;
   // A degenerate match moves the pose along its weak direction by at most this many prior σ from the prior.
   static constexpr double kDegenerateStepSigmas = 3.0;
-  // s of matches outside blank stretches the held speed is fitted to, and the shortest window tried.
-  static constexpr double kHoldSpeedWindow = 3.0;
+  // s of constrained matches the held speed is fitted to, and the shortest window tried. Their positions
+  // jitter by 1-2 cm, so a 3 s fit was several per cent off; over 12 s a 40 m blank corridor ends within
+  // 0.5 % (doc/experiments.md, "The held speed fitted to the matches that measured it").
+  static constexpr double kHoldSpeedWindow = 12.0;
   static constexpr double kMinHoldSpeedWindow = 0.5;
   // The window's two halves agree within this fraction of the speed plus kHoldSpeedAgreementMin (m/s).
   static constexpr double kHoldSpeedAgreement = 0.03;
   static constexpr double kHoldSpeedAgreementMin = 0.005;
+  // rad: a pose turned more than this from the newest ends the straight run the held speed is fitted over.
+  static constexpr double kStraightRunHeading = 0.05;
   static constexpr double kNoConstrainedMatch = -1e300;  ///< constrained_stamp_ when there is nothing to hold
   double constrained_stamp_ = kNoConstrainedMatch;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
   double held_since_ = kNoConstrainedMatch;  ///< stamp of the first scan of the current hold (none: not holding)
@@ -235,7 +239,8 @@ class LaserOdometry {
   RangeFlow last_flow_;              ///< the range flow measured with the last scan (invalid: none)
   Eigen::Vector2d last_flow_direction_ = Eigen::Vector2d::Zero();  ///< its direction (the match's weak direction, matching frame)
   Eigen::Vector2d last_weak_ = Eigen::Vector2d::Zero();  ///< the last match's weak direction if it was degenerate (matching frame), else 0
-  std::deque<std::pair<double, Pose2D>> seen_along_;  ///< poses of the last kHoldSpeedWindow s of matches outside blank stretches
+  std::deque<std::pair<double, Pose2D>> seen_along_;  ///< stamped poses of constrained matches on the current straight run
+  double fitted_through_ = kNoConstrainedMatch;  ///< stamp of the newest pose the last held speed was fitted to
   bool was_blank_ = false;  ///< the last scan was in a blank stretch (velocity_held_blank)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;

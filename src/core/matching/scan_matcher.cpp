@@ -107,7 +107,8 @@ bool ScanMatcher::degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* we
   return !(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12));
 }
 
-Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior, MatchResult& r) const {
+Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior,
+                                            const Eigen::Vector2d& unconstrained, MatchResult& r) const {
   // Σ = α·H⁻¹ + Σ_min (doc/algorithms.md §2): h is not a normalised likelihood, so H⁻¹ alone is
   // over-confident. H's eigenvalues are floored so that a singular H still gives a finite (large) Σ.
   const Eigen::Matrix3d Hs = 0.5 * (hessian + hessian.transpose());
@@ -118,6 +119,10 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool
   // the covariance with a large σ along it, rather than trusting a tiny curvature.
   Eigen::Vector2d v;
   r.degenerate = degenerate(Hs, &v);
+  if (!r.degenerate && unconstrained.squaredNorm() > 0.0) {
+    r.degenerate = true;
+    v = unconstrained;
+  }
   if (r.degenerate) r.weak_direction = v;
   auto fromEigenvalues = [&](const Eigen::Vector3d& ev) {
     Eigen::Matrix3d cov = config_.covariance_scale * es.eigenvectors() * ev.cwiseMax(floor).cwiseInverse().asDiagonal() *
@@ -235,13 +240,20 @@ void ScanMatcher::rescueWeak(const MatchInput& in, const std::mt19937_64& rng, P
 
 void ScanMatcher::keepPriorAlongWeak(const MatchInput& in, Pose2D* pose, NdtScore* s, MatchResult& r) const {
   Eigen::Vector2d v;
-  if (!degenerate(s->hessian, &v)) return;
+  if (!degenerate(s->hessian, &v)) {
+    if (in.unconstrained.squaredNorm() == 0.0) return;
+    v = in.unconstrained;
+  }
   const Eigen::Vector2d d(pose->x - in.prior.x, pose->y - in.prior.y);
   const Eigen::Vector2d xy = Eigen::Vector2d(pose->x, pose->y) - v * v.dot(d);
   Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
   basis << -v.y(), 0.0, v.x(), 0.0, 0.0, 1.0;
-  *pose = polish(in.polish_points, Pose2D(xy.x(), xy.y(), pose->theta), grids_.size() - 1, &r.newton_iterations,
-                 &basis);
+  const Pose2D held(xy.x(), xy.y(), pose->theta);
+  const Pose2D polished = polish(in.polish_points, held, grids_.size() - 1, &r.newton_iterations, &basis);
+  // Where the score does constrain the direction held (a forced `unconstrained`), the pose moved along it
+  // can sit on a slope that sends the polish far in heading, even to the corridor's mirror image (π): a
+  // step beyond the search window is not a refinement, so the held pose stays as it is.
+  *pose = std::abs(normalizeAngle(polished.theta - held.theta)) <= config_.window_theta ? polished : held;
   *s = grids_.back().score(*pose, in.polish_points, true);
 }
 
@@ -260,11 +272,14 @@ void ScanMatcher::releasePrior(const MatchInput& in, const Eigen::Vector2d& weak
 MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
                                const std::vector<Eigen::Vector2d>& polish_points, const Pose2D& prior,
                                std::mt19937_64& rng, double prior_sigma_xy, bool allow_prior_release,
-                               bool hold_prior_when_degenerate) const {
+                               bool hold_prior_when_degenerate, const Eigen::Vector2d& unconstrained) const {
   MatchResult r;
   r.pose = prior;
   if (!hasReference() || points.empty() || polish_points.empty()) return r;
-  const MatchInput in{points, polish_points, prior, prior_sigma_xy, static_cast<double>(polish_points.size())};
+  const Eigen::Vector2d along = hold_prior_when_degenerate && unconstrained.squaredNorm() > 0.0
+                                    ? Eigen::Vector2d(unconstrained.normalized())
+                                    : Eigen::Vector2d::Zero();
+  const MatchInput in{points, polish_points, prior, prior_sigma_xy, static_cast<double>(polish_points.size()), along};
 
   // DE over a window around the prior (doc/algorithms.md §3), the prior seeded into the population; then
   // the Newton polish coarse to fine, and the exact score at the finest resolution.
@@ -299,14 +314,21 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     // when it scores higher and lies well outside the prior's σ along the weak direction.
     releasePrior(in, weak, prior_sigma_xy, &pose, &s, r);
   }
+  // The search covered ±window_theta around the prior (±rescue_window_theta for a retried weak match); the
+  // Newton polish is local, but where h is nearly flat in heading (a featureless corridor) its step can be
+  // huge and backtracking accepts any decrease, down to the corridor's mirror image half a turn away. A
+  // heading beyond the search is not a match.
+  const double max_turn = config_.rescue_margin > 0.0 ? std::max(config_.window_theta, config_.rescue_window_theta)
+                                                      : config_.window_theta;
+  const bool beyond_search = std::abs(normalizeAngle(pose.theta - prior.theta)) > max_turn;
   r.pose = pose;
 
   r.hessian = s.hessian;
   r.score_per_point = scorePerPoint(in, s);
   r.matched_fraction = static_cast<double>(s.matched) / in.n;
   r.weak = isWeak(in, s);
-  r.covariance = covarianceFrom(s.hessian, prior_sigma_xy > 0.0, r);
-  r.valid = r.pose.vector().allFinite() && r.covariance.allFinite();
+  r.covariance = covarianceFrom(s.hessian, prior_sigma_xy > 0.0, in.unconstrained, r);
+  r.valid = r.pose.vector().allFinite() && r.covariance.allFinite() && !beyond_search;
   if (!r.valid) r.pose = prior;
   return r;
 }

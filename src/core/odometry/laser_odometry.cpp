@@ -39,6 +39,7 @@ void LaserOdometry::reset() {
   last_weak_.setZero();
   seen_along_.clear();
   was_blank_ = false;
+  fitted_through_ = kNoConstrainedMatch;
 }
 
 void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points, const PreprocessedScan& scan,
@@ -301,7 +302,9 @@ void LaserOdometry::matchToLocalMap(const PreprocessedScan& scan, const LaserMou
   const bool hold = u.wheel_prior || u.velocity_held_blank;
   const bool may_release = !hold && config_.prior_release_speed > 0.0 &&
                            velocity_.head<2>().norm() < config_.prior_release_speed;
-  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release, hold);
+  // In a blank stretch the corridor's direction is unconstrained whatever the score's curvature says.
+  const Eigen::Vector2d unconstrained = u.velocity_held_blank ? last_weak_ : Eigen::Vector2d::Zero();
+  u.match = matcher_.match(match_points, polish_points, prior, rng_, prior_sigma, may_release, hold, unconstrained);
   if (short_range && !u.wheel_prior) limitDegenerateStep(prior, prior_sigma, u.match);
   last_weak_ = u.match.valid && u.match.degenerate ? u.match.weak_direction : Eigen::Vector2d::Zero();
 }
@@ -431,17 +434,37 @@ void LaserOdometry::limitDegenerateStep(const Pose2D& prior, double prior_sigma,
 }
 
 void LaserOdometry::seeAlongCorridor(double stamp, const OdometryUpdate& u) {
-  while (!seen_along_.empty() && seen_along_.front().first < stamp - kHoldSpeedWindow) seen_along_.pop_front();
-  if (u.velocity_held_blank && !was_blank_) holdSpeedFromSeenMatches(stamp, u.match.weak_direction);
-  if (!u.velocity_held_blank) seen_along_.push_back({stamp, pose_});
+  // seen_along_ spans kHoldSpeedWindow s back from its newest pose, not from now: degenerate matches between
+  // it and a blank stretch (a corridor's last metres before it turns blank) do not age it out.
+  const double newest =
+      seen_along_.empty() ? stamp : std::max(seen_along_.back().first, stamp - kHoldSpeedWindow);
+  while (!seen_along_.empty() && seen_along_.front().first < newest - kHoldSpeedWindow) seen_along_.pop_front();
+  // A blank stretch starts: fit the held speed, unless no match has measured the motion since the last fit
+  // (the blank test flickering at a stretch's edge), in which case the speed held stands.
+  const bool measured_since = seen_along_.empty() || seen_along_.back().first > fitted_through_;
+  if (u.velocity_held_blank && !was_blank_ && measured_since) {
+    holdSpeedFromSeenMatches(stamp, u.match.weak_direction);
+    fitted_through_ = seen_along_.empty() ? stamp : seen_along_.back().first;
+  }
+  // Only matches that measured the motion along every direction, on the current straight run: a degenerate
+  // match's position along the corridor is the prior's plus the score's ripple (it lags), and a turn ends the
+  // run whose speed is fitted.
+  if (!u.match.degenerate && !u.match.weak && !u.velocity_held_blank) {
+    while (!seen_along_.empty() &&
+           std::abs(normalizeAngle(seen_along_.front().second.theta - pose_.theta)) > kStraightRunHeading) {
+      seen_along_.pop_front();
+    }
+    seen_along_.push_back({stamp, pose_});
+  }
   was_blank_ = u.velocity_held_blank;
 }
 
 void LaserOdometry::holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d& weak) {
-  // A blank stretch starts: the speed it keeps along the corridor is fitted to the last seconds of matches
-  // that saw something along it, rather than the last few scans' smoothed velocity (a few per cent off,
-  // which a 40 m corridor turns into metres). The window halves until its two halves agree (no acceleration
-  // inside it); with no such window the smoothed velocity stays. seen_along_ holds the last kHoldSpeedWindow s.
+  // A blank stretch starts: the speed it keeps along the corridor is a line fitted to the positions of the
+  // constrained matches of the straight run before it (up to kHoldSpeedWindow s), rather than the last few
+  // scans' smoothed velocity (a few per cent off, which a 40 m corridor turns into metres). The window
+  // halves until its two halves agree (no acceleration inside it); with no such window the smoothed
+  // velocity stays.
   const Eigen::Matrix2d frame = pose_.rotation();
   const Eigen::Vector2d w = frame.transpose() * weak;  // base frame
   const double end = seen_along_.empty() ? stamp : seen_along_.back().first;
