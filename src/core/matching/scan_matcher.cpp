@@ -314,12 +314,11 @@ MatchResult ScanMatcher::match(const std::vector<Eigen::Vector2d>& points,
     // when it scores higher and lies well outside the prior's σ along the weak direction.
     releasePrior(in, weak, prior_sigma_xy, &pose, &s, r);
   }
-  // The search covered ±window_theta around the prior (±rescue_window_theta for a retried weak match); the
-  // Newton polish is local, but where h is nearly flat in heading (a featureless corridor) its step can be
-  // huge and backtracking accepts any decrease, down to the corridor's mirror image half a turn away. A
-  // heading beyond the search is not a match.
-  const double max_turn = config_.rescue_margin > 0.0 ? std::max(config_.window_theta, config_.rescue_window_theta)
-                                                      : config_.window_theta;
+  // The widest search turns the prior by ±rescue_window_theta (a retried weak match), and the polish may
+  // converge a little beyond DE's window. But where h is nearly flat in heading (a featureless corridor) a
+  // Newton step can be huge and backtracking accepts any decrease, down to the corridor's mirror image half
+  // a turn away. A heading beyond the widest search is not a match.
+  const double max_turn = std::max(config_.window_theta, config_.rescue_window_theta);
   const bool beyond_search = std::abs(normalizeAngle(pose.theta - prior.theta)) > max_turn;
   r.pose = pose;
 
