@@ -166,6 +166,8 @@ class ScanMatcher {
   /// True when H's translation block has a direction the scan barely constrains (degeneracy_ratio); that
   /// direction (unit) into *weak.
   bool degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* weak) const;
+  /// degenerate(), or else `unconstrained` when non-zero (a direction the caller knows is not measured).
+  bool weakDirection(const Eigen::Matrix3d& hessian, const Eigen::Vector2d& unconstrained, Eigen::Vector2d* weak) const;
   /// Weight w of the motion prior's penalty ½·w·|xy − prior|² in h's units (Σ = α·H⁻¹ ⇒ information α⁻¹·H);
   /// 0 without a prior.
   double priorWeight(double prior_sigma_xy) const {

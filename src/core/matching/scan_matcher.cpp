@@ -107,6 +107,14 @@ bool ScanMatcher::degenerate(const Eigen::Matrix3d& hessian, Eigen::Vector2d* we
   return !(et.eigenvalues()(0) > config_.degeneracy_ratio * std::max(et.eigenvalues()(1), 1e-12));
 }
 
+bool ScanMatcher::weakDirection(const Eigen::Matrix3d& hessian, const Eigen::Vector2d& unconstrained,
+                                Eigen::Vector2d* weak) const {
+  if (degenerate(hessian, weak)) return true;
+  if (unconstrained.squaredNorm() == 0.0) return false;
+  *weak = unconstrained;
+  return true;
+}
+
 Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool with_prior,
                                             const Eigen::Vector2d& unconstrained, MatchResult& r) const {
   // Σ = α·H⁻¹ + Σ_min (doc/algorithms.md §2): h is not a normalised likelihood, so H⁻¹ alone is
@@ -118,11 +126,7 @@ Eigen::Matrix3d ScanMatcher::covarianceFrom(const Eigen::Matrix3d& hessian, bool
   // Degeneracy (corridors, a single wall): a translation direction the scan barely constrains. Say so in
   // the covariance with a large σ along it, rather than trusting a tiny curvature.
   Eigen::Vector2d v;
-  r.degenerate = degenerate(Hs, &v);
-  if (!r.degenerate && unconstrained.squaredNorm() > 0.0) {
-    r.degenerate = true;
-    v = unconstrained;
-  }
+  r.degenerate = weakDirection(Hs, unconstrained, &v);
   if (r.degenerate) r.weak_direction = v;
   auto fromEigenvalues = [&](const Eigen::Vector3d& ev) {
     Eigen::Matrix3d cov = config_.covariance_scale * es.eigenvectors() * ev.cwiseMax(floor).cwiseInverse().asDiagonal() *
@@ -240,10 +244,7 @@ void ScanMatcher::rescueWeak(const MatchInput& in, const std::mt19937_64& rng, P
 
 void ScanMatcher::keepPriorAlongWeak(const MatchInput& in, Pose2D* pose, NdtScore* s, MatchResult& r) const {
   Eigen::Vector2d v;
-  if (!degenerate(s->hessian, &v)) {
-    if (in.unconstrained.squaredNorm() == 0.0) return;
-    v = in.unconstrained;
-  }
+  if (!weakDirection(s->hessian, in.unconstrained, &v)) return;
   const Eigen::Vector2d d(pose->x - in.prior.x, pose->y - in.prior.y);
   const Eigen::Vector2d xy = Eigen::Vector2d(pose->x, pose->y) - v * v.dot(d);
   Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
