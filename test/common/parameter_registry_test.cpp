@@ -94,7 +94,7 @@ TEST(ParameterRegistry, OutOfRangeValuesNameTheKeyTheValueAndTheRange) {
   };
   EXPECT_EQ(odometryError("de_CR: 1.5"), "parameter 'de_CR' = 1.5 is outside its range [0, 1]");
   EXPECT_EQ(odometryError("de_population: 3"), "parameter 'de_population' = 3 is outside its range >= 4");
-  EXPECT_EQ(odometryError("velocity_gain: 0"), "parameter 'velocity_gain' = 0.0 is outside its range (0, 1]");
+  EXPECT_EQ(odometryError("window_xy: 0"), "parameter 'window_xy' = 0.0 is outside its range > 0");
   EXPECT_EQ(odometryError("ndt_cell_sizes: []"), "parameter 'ndt_cell_sizes' must not be empty");
   EXPECT_EQ(odometryError("resampling: random"),
             "parameter 'resampling' = 'random': must be one of none, every_kth, uniform, saliency");

@@ -46,7 +46,6 @@ const SimRun& loopRun() {
     odometry_config.matcher.rescue_margin = 0.0;
     odometry_config.matcher.degenerate_sigma_with_prior = 0.3;
     odometry_config.degenerate_velocity_gain = -1.0;
-    odometry_config.degenerate_hold_time = 0.0;
     odometry_config.range_flow_gain = 0.0;
     LaserOdometry odom(odometry_config);
     for (const auto& tp : r.truth) {

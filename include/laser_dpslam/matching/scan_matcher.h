@@ -19,7 +19,6 @@ namespace laser_dpslam {
 struct ScanMatcherConfig {
   std::vector<double> cell_sizes{1.0, 0.5};  ///< m, NDT resolutions, coarse to fine; DE runs on the first
   NdtGridConfig ndt;                         ///< cell_size is overwritten by each of cell_sizes
-  double raster_resolution = 0.03;           ///< m, sample spacing of the DE score raster
 
   // Differential Evolution (doc/algorithms.md §3).
   bool use_de = true;                 ///< false: Newton from the prior only (for comparison)
@@ -56,12 +55,6 @@ struct ScanMatcherConfig {
   /// odometry's turn failures (MIT CSAIL at 4.7 Hz, an in-place turn of the loop building); see doc/benchmarks.md.
   double rescue_margin = 0.05;
   double rescue_window_theta = 0.79;    ///< rad, θ half-width of the retry's DE window (≈ 45°)
-  /// Prior release (only where the caller allows it, see LaserOdometryConfig::prior_release_speed): a
-  /// degenerate match held by the soft motion prior is polished again without it; the result replaces it when
-  /// its score per point is higher by more than this and it lies more than prior_release_sigmas × the prior's
-  /// σ away along the weak direction (the prior, not the scan, was wrong: a robot starting to move).
-  double prior_release_margin = 0.005;
-  double prior_release_sigmas = 3.0;   ///< see prior_release_margin
 };
 
 struct MatchResult {
@@ -79,7 +72,7 @@ struct MatchResult {
   bool degenerate = false;        ///< a direction is unconstrained (corridor, single wall)
   Eigen::Vector2d weak_direction = Eigen::Vector2d::Zero();  ///< unit, reference frame: that direction (when degenerate)
   bool weak = false;              ///< low score or low overlap
-  bool prior_released = false;    ///< the motion prior was dropped (prior_release_margin)
+  bool prior_released = false;    ///< the motion prior was dropped (kPriorReleaseMargin)
   int de_generations = 0;
   int de_evaluations = 0;
   int newton_iterations = 0;
@@ -105,7 +98,7 @@ class ScanMatcher {
   /// `prior_sigma_xy` > 0: the Newton polish minimises h + α/2·|t − t_prior|²/σ² (a Gaussian motion prior of
   /// this σ on the translation, in h's units through Σ = α·H⁻¹): where the scan constrains the pose the data
   /// wins, along a corridor the prior does, with no hard degeneracy threshold. ≤ 0: no prior.
-  /// `allow_prior_release`: a degenerate match may drop that prior (ScanMatcherConfig::prior_release_margin).
+  /// `allow_prior_release`: a degenerate match may drop that prior (kPriorReleaseMargin).
   /// `hold_prior_when_degenerate`: along a degenerate direction keep the prior exactly (the prior is a
   /// measurement there: wheel odometry, or a blank stretch of corridor).
   /// `unconstrained` (non-zero, with the hold): a translation direction the caller knows the scan does not
@@ -135,6 +128,18 @@ class ScanMatcher {
   Eigen::Matrix3d boundedByWindow(const Eigen::Matrix3d& cov) const;
 
  private:
+  // m, sample spacing of the score raster DE evaluates (NdtScoreRaster): finer than the 5 cm lattice that
+  // floor plans' walls often lie on. At 0.05 m a matching frame a few tenths of a degree off such walls made
+  // the search drift along corridors; 0.03 m costs about a third more odometry CPU (doc/benchmarks.md).
+  static constexpr double kRasterResolution = 0.03;
+  // Prior release (where the caller allows it, LaserOdometryConfig::prior_release_speed): a degenerate match
+  // held by the soft motion prior is polished again without it, and that pose replaces it when its score per
+  // point is higher by more than kPriorReleaseMargin and it lies more than kPriorReleaseSigmas prior σ away
+  // along the weak direction: the prior, not the scan, was wrong (a robot starting to move). 0.004 also fired
+  // on scan noise while standing still, 0.005 did not in 42 standing tests of 30 s
+  // (LaserOdometry.PriorReleaseDoesNotFireWhileStandingStill).
+  static constexpr double kPriorReleaseMargin = 0.005;
+  static constexpr double kPriorReleaseSigmas = 3.0;
   /// The Newton step at s (the Hessian made positive definite), within `basis`'s span when given.
   static Eigen::Vector3d newtonStep(const NdtScore& s, const Eigen::Matrix<double, 3, Eigen::Dynamic>* basis);
   /// What the steps of one match() share.

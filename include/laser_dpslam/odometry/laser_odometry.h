@@ -33,29 +33,18 @@ struct LaserOdometryConfig {
   /// σ = ½·a·dt² (the displacement an unmodelled acceleration a causes over the scan interval dt), see
   /// ScanMatcher::match. 0 = off.
   double prior_acceleration = 2.0;
-  /// (0, 1]: weight of the newest scan-to-scan translation velocity in the constant-velocity prior
-  /// (exponential smoothing per scan; 1 = the last motion only). 0.3 from scripts/benchmark_loop.sh and CSAIL.
-  double velocity_gain = 0.3;
   /// A new keyframe is also taken when the matched fraction fell this much below the first match after the
   /// last keyframe: new structure came into view that the local map lacks (0 = off). Without it a robot whose
   /// estimate stalls in a corridor never takes the keyframe that would show it the wall ahead.
   double keyframe_overlap_drop = 0.1;
-  /// [0, 1]: velocity_gain along the unconstrained direction of a degenerate match (corridor), where the
-  /// match's motion is mostly the prior plus the score's ripple; < velocity_gain averages that ripple
-  /// over more scans. Negative = velocity_gain. Applies only to short-range lasers (below).
+  /// [0, 1]: kVelocityGain along the unconstrained direction of a degenerate match (corridor), where the
+  /// match's motion is mostly the prior plus the score's ripple; < kVelocityGain averages that ripple
+  /// over more scans. Negative = kVelocityGain. Applies only to short-range lasers (below).
   double degenerate_velocity_gain = 0.1;
   /// m; degenerate_velocity_gain applies when the scan's effective range_max is at most this (0 = always).
   /// A short-range laser sees little along a corridor and the ripple dominates (CSAIL cut to 5.6 m: SLAM
   /// error −39 %); a long-range one sees far structure and real speed changes (full-range CSAIL: worse).
   double degenerate_velocity_max_range = 10.0;
-  /// s; > 0: for this long after the last match that fixed the position along every direction, a degenerate
-  /// match (same range gate) leaves the velocity along its weak direction as it was: the velocity measured
-  /// there carries the robot through a featureless stretch, where each match's small pull back towards the
-  /// local map would otherwise slow it down scan after scan. A released prior (prior_release_speed) ends the
-  /// hold: the scan refuted that velocity. 0 = off; infinite (the default): until the scan fixes every
-  /// direction again, as a constant-velocity model keeps an unobserved velocity (a time limit made the
-  /// estimate stall in corridors longer than it: generated buildings, doc/experiments.md).
-  double degenerate_hold_time = std::numeric_limits<double>::infinity();
   /// [0, 1]; > 0: where a degenerate match (same range gate) has lines in view that face along its weak
   /// direction (a niche, a door frame, a pillar), the speed along that direction is also measured from how
   /// their ranges changed since the previous scan (measureRangeFlow). When two consecutive flows agree and
@@ -66,7 +55,7 @@ struct LaserOdometryConfig {
   double range_flow_gain = 0.3;
   RangeFlowConfig range_flow;
   /// m/s; > 0: while the estimated speed is below this, a degenerate (corridor) match may drop the motion
-  /// prior when the scan fits clearly better without it (ScanMatcherConfig::prior_release_margin). Starting
+  /// prior when the scan fits clearly better without it (ScanMatcher::kPriorReleaseMargin). Starting
   /// from rest in a corridor, the prior says "at rest" and the smoothed velocity catches up slowly: the
   /// loop building's start lost 0.6–1.2 m in 5 s (0.04–0.12 m with it; scripts/benchmark_loop.sh). 0 = off.
   double prior_release_speed = 0.15;
@@ -77,7 +66,7 @@ struct LaserOdometryConfig {
   /// more along corridors: on the loop building started a few degrees off the walls, odometry ATE mean
   /// 0.187 m over seeds 1–12, 0.092 m with this on (doc/experiments.md). With walls lying exactly on a 5 cm
   /// lattice (a simulated plan, a start on a pixel) the estimate's ~0.3° error made the 0.05 m DE raster drift:
-  /// on by default together with ScanMatcherConfig::raster_resolution 0.03.
+  /// on by default together with the DE raster's 0.03 m spacing (ScanMatcher::kRasterResolution).
   bool align_to_walls = true;
   double wall_alignment_min_strength = 0.3;  ///< [0, 1]
   int min_points = 20;               ///< fewer valid points: the scan is skipped
@@ -106,7 +95,7 @@ struct OdometryUpdate {
   MatchResult match;                  ///< its pose and weak_direction are in the matching frame (frameAngle())
   RangeFlow range_flow;               ///< the speed along match.weak_direction from the range flow (range_flow_gain)
   bool range_flow_applied = false;    ///< it (with the previous scan's) refuted the velocity and moved it
-  /// The velocity along match.weak_direction was held (degenerate_hold_time): the pose's variance along it
+  /// The velocity along match.weak_direction was held (velocityAlongCorridor): the pose's variance along it
   /// grows with the time held.
   bool velocity_held = false;
   bool velocity_held_blank = false;  ///< no surface in the scan faces along the corridor: the match kept the prior along it
@@ -123,6 +112,12 @@ struct OdometryUpdate {
 
 class LaserOdometry {
  public:
+  /// Weight of the newest scan-to-scan translation velocity in the constant-velocity prior (exponential
+  /// smoothing per scan). The last motion alone (1) feeds each match's small bias along a corridor straight
+  /// back into the next prior: on the generated buildings the odometry's drift median went 0.33 / 0.34 % →
+  /// 0.54 / 0.65 % (search seeds 1 / 2, doc/experiments.md "Which corridor rules earn their place").
+  static constexpr double kVelocityGain = 0.3;
+
   explicit LaserOdometry(const LaserOdometryConfig& config = LaserOdometryConfig());
 
   /// Processes one preprocessed scan (laser frame) with the laser's mount on the robot.
@@ -196,7 +191,14 @@ class LaserOdometry {
   /// Where the velocity was held: the pose's variance along the weak direction grows with the time held,
   /// as that velocity's error does.
   void heldCovariance(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u);
-  /// velocity_ along a degenerate match's weak direction: held, or moved by the range flow.
+  /// velocity_ along a degenerate match's weak direction. Once a match has fixed every direction, a degenerate
+  /// match leaves the velocity along its weak direction as it was, with no time limit, as a constant-velocity
+  /// model keeps a velocity nothing observes: where nothing along a corridor is in range each match pulls a
+  /// little back towards the local map, and taken into the velocity that slows the estimate scan after scan
+  /// (the loop building's west corridor lost 0.10-0.36 m; a 10 s limit stalled the estimate in the generated
+  /// buildings' longer corridors, doc/experiments.md). Only the range flow moves it (a stop or a start seen
+  /// against the previous scan), and a released prior ends the hold (the scan refuted that velocity). Before
+  /// any constrained match, or after a release, degenerate_velocity_gain smooths it instead.
   void velocityAlongCorridor(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous,
                              double dt, const Eigen::Vector2d& before, const Eigen::Vector3d& measured,
                              OdometryUpdate& u);
@@ -231,16 +233,18 @@ class LaserOdometry {
   static constexpr double kHoldSpeedAgreementMin = 0.005;
   // rad: a pose turned more than this from the newest ends the straight run the held speed is fitted over.
   static constexpr double kStraightRunHeading = 0.05;
-  static constexpr double kNoConstrainedMatch = -1e300;  ///< constrained_stamp_ when there is nothing to hold
-  double constrained_stamp_ = kNoConstrainedMatch;  ///< stamp of the last match neither degenerate nor weak (degenerate_hold_time)
-  double held_since_ = kNoConstrainedMatch;  ///< stamp of the first scan of the current hold (none: not holding)
+  static constexpr double kNoStamp = -1e300;  ///< held_since_ / fitted_through_: none
+  /// A match neither degenerate nor weak has measured the velocity since the start, a gap or a released
+  /// prior: degenerate matches hold it along their weak direction (velocityAlongCorridor).
+  bool velocity_measured_ = false;
+  double held_since_ = kNoStamp;  ///< stamp of the first scan of the current hold (none: not holding)
   double held_start_variance_ = 0.0;  ///< m², the pose's variance along the held direction then
   PreprocessedScan previous_scan_;  ///< the last scan matched (range_flow_gain)
   RangeFlow last_flow_;              ///< the range flow measured with the last scan (invalid: none)
   Eigen::Vector2d last_flow_direction_ = Eigen::Vector2d::Zero();  ///< its direction (the match's weak direction, matching frame)
   Eigen::Vector2d last_weak_ = Eigen::Vector2d::Zero();  ///< the last match's weak direction if it was degenerate (matching frame), else 0
   std::deque<std::pair<double, Pose2D>> seen_along_;  ///< stamped poses of constrained matches on the current straight run
-  double fitted_through_ = kNoConstrainedMatch;  ///< stamp of the newest pose the last held speed was fitted to
+  double fitted_through_ = kNoStamp;  ///< stamp of the newest pose the last held speed was fitted to
   bool was_blank_ = false;  ///< the last scan was in a blank stretch (velocity_held_blank)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;

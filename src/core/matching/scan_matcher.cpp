@@ -22,7 +22,7 @@ void ScanMatcher::setReference(const std::vector<Eigen::Vector2d>& points, const
     c.cell_size = config_.cell_sizes[i];
     grids_[i].build(points, c, views);
   }
-  if (config_.use_de) raster_.build(grids_.front(), config_.raster_resolution);
+  if (config_.use_de) raster_.build(grids_.front(), kRasterResolution);
 }
 
 bool ScanMatcher::hasReference() const { return !grids_.empty() && !grids_.back().empty(); }
@@ -262,8 +262,8 @@ void ScanMatcher::releasePrior(const MatchInput& in, const Eigen::Vector2d& weak
                                NdtScore* s, MatchResult& r) const {
   NdtScore fs;
   const Pose2D free = polishAll(in, *pose, &fs, r, false);
-  if (scorePerPoint(in, fs) > scorePerPoint(in, *s) + config_.prior_release_margin &&
-      std::abs(weak.dot(Eigen::Vector2d(free.x - pose->x, free.y - pose->y))) > config_.prior_release_sigmas * prior_sigma) {
+  if (scorePerPoint(in, fs) > scorePerPoint(in, *s) + kPriorReleaseMargin &&
+      std::abs(weak.dot(Eigen::Vector2d(free.x - pose->x, free.y - pose->y))) > kPriorReleaseSigmas * prior_sigma) {
     *pose = free;
     *s = fs;
     r.prior_released = true;

@@ -34,12 +34,12 @@ void LaserOdometry::reset() {
   keyframes_.clear();
   rng_.seed(config_.seed);
   scan_count_ = 0;
-  constrained_stamp_ = kNoConstrainedMatch;
-  held_since_ = kNoConstrainedMatch;
+  velocity_measured_ = false;
+  held_since_ = kNoStamp;
   last_weak_.setZero();
   seen_along_.clear();
   was_blank_ = false;
-  fitted_through_ = kNoConstrainedMatch;
+  fitted_through_ = kNoStamp;
 }
 
 void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points, const PreprocessedScan& scan,
@@ -212,12 +212,12 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
     seeAlongCorridor(scan.stamp, u);
     heldCovariance(previous, scan.stamp, dt, u);
   } else {
-    held_since_ = kNoConstrainedMatch;
+    held_since_ = kNoStamp;
     last_flow_ = RangeFlow();
     velocity_.setZero();
-    constrained_stamp_ = kNoConstrainedMatch;  // nothing measured to hold
+    velocity_measured_ = false;  // nothing measured to hold
   }
-  if (!u.match.degenerate && !u.match.weak) constrained_stamp_ = scan.stamp;
+  if (!u.match.degenerate && !u.match.weak) velocity_measured_ = true;
   last_stamp_ = scan.stamp;
 
   if (keyframeDue(u.match)) {
@@ -331,7 +331,7 @@ void LaserOdometry::matchCovariances(const Pose2D& previous, OdometryUpdate& u) 
 
 void LaserOdometry::heldCovariance(const Pose2D& previous, double stamp, double dt, OdometryUpdate& u) {
   if (!u.velocity_held || u.wheel_prior) {
-    held_since_ = kNoConstrainedMatch;
+    held_since_ = kNoStamp;
     return;
   }
   // A velocity error is the same at every scan of the hold, so the position's error along the corridor
@@ -342,7 +342,7 @@ void LaserOdometry::heldCovariance(const Pose2D& previous, double stamp, double 
   const double sigma_v = kHeldSpeedSigma * std::abs(weak.dot(velocity_.head<2>())) + kHeldMinSpeedSigma;
   const Eigen::Vector2d w = u.match.weak_direction;  // matching frame, as pose_covariance_
   const double along = w.dot(pose_covariance_.topLeftCorner<2, 2>() * w);
-  if (held_since_ == kNoConstrainedMatch) {
+  if (held_since_ == kNoStamp) {
     held_since_ = stamp - dt;
     held_start_variance_ = along;
   }
@@ -356,17 +356,17 @@ void LaserOdometry::heldCovariance(const Pose2D& previous, double stamp, double 
 
 void LaserOdometry::updateVelocity(const PreprocessedScan& scan, const LaserMount& mount, const Pose2D& previous,
                                    double dt, OdometryUpdate& u) {
-  // Translation: exponential smoothing (velocity_gain). Taking the last motion as the velocity feeds any
+  // Translation: exponential smoothing (kVelocityGain). Taking the last motion as the velocity feeds any
   // small per-match bias along a corridor back into the prior, where it adds up twice (a lag growing with
   // the square of the scans: maps come out too short); the smoothing scales that feedback by the gain.
   // Rotation: the last motion (turns start and stop fast; the heading is well constrained anyway).
   const Eigen::Vector3d measured = Eigen::Vector3d(u.delta.x, u.delta.y, u.delta.theta) / dt;
-  const double g = config_.velocity_gain;
+  const double g = kVelocityGain;
   const Eigen::Vector2d before = velocity_.head<2>();
   velocity_.head<2>() = (1.0 - g) * before + g * measured.head<2>();
   const bool short_range = shortRange(scan);
   // A released prior was refuted by the scan: nothing left to hold.
-  if (u.match.prior_released) constrained_stamp_ = kNoConstrainedMatch;
+  if (u.match.prior_released) velocity_measured_ = false;
   if (short_range && u.match.degenerate) velocityAlongCorridor(scan, mount, previous, dt, before, measured, u);
   velocity_.z() = measured.z();
   last_flow_ = u.range_flow;
@@ -376,10 +376,9 @@ void LaserOdometry::updateVelocity(const PreprocessedScan& scan, const LaserMoun
 void LaserOdometry::velocityAlongCorridor(const PreprocessedScan& scan, const LaserMount& mount,
                                           const Pose2D& previous, double dt, const Eigen::Vector2d& before,
                                           const Eigen::Vector3d& measured, OdometryUpdate& u) {
-  const double g = config_.velocity_gain;
+  const double g = kVelocityGain;
   const double gw = config_.degenerate_velocity_gain;
-  const bool hold = config_.degenerate_hold_time > 0.0 && constrained_stamp_ != kNoConstrainedMatch &&
-                    scan.stamp - constrained_stamp_ <= config_.degenerate_hold_time;
+  const bool hold = velocity_measured_;
   const Eigen::Vector2d weak = previous.rotation().transpose() * u.match.weak_direction;
   if (config_.range_flow_gain > 0.0 && previous_scan_.stamp == last_stamp_) {
     u.range_flow = measureRangeFlow(previous_scan_, scan, mount, u.delta, weak, dt, config_.range_flow);

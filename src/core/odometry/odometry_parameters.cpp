@@ -111,10 +111,6 @@ std::vector<Parameter<S>> matchingEntries() {
        "stop losing to fat corner cells (`ScanMatcher.PointSigmaRemovesTheCorridorPullTowardsCorners`); opt-in, as "
        "the running odometry does not gain yet (loop building ATE 0.093 m at 0.015 against 0.095 m); 0 = off",
        kAdvanced},
-      {"raster_resolution", "matching", FIELD(odometry.matcher.raster_resolution), "m", above(0),
-       "sample spacing of the score raster DE evaluates (finer than the 5 cm lattice a floor plan's walls often "
-       "sit on)",
-       kAdvanced},
       {"use_de", "matching", FIELD(odometry.matcher.use_de), "bool", anyValue(),
        "false = Newton from the motion prior only", kAdvanced},
       {"de_CR", "matching", FIELD(odometry.matcher.de_CR), "-", closedInterval(0, 1), "DE crossover rate",
@@ -146,24 +142,16 @@ std::vector<Parameter<S>> motionPriorEntries() {
        "along corridors; when DE ends more than 3 sigma from the prior the polish also starts from the prior and "
        "the lower value wins); 0 = off",
        kAdvanced},
-      {"velocity_gain", "motion prior", FIELD(odometry.velocity_gain), "-", leftOpenInterval(0, 1),
-       "weight of the newest scan's translation velocity in the prior's velocity (exponential smoothing; 1 = the "
-       "last motion only): small per-match biases along corridors do not add up",
-       kAdvanced},
       {"degenerate_velocity_gain", "motion prior", FIELD(odometry.degenerate_velocity_gain), "-", atMost(1),
-       "velocity_gain along the weak direction of a degenerate (corridor) match; averages the NDT score's ripple "
-       "over more scans so the estimate does not stall (CSAIL cut to 5.6 m: SLAM error -39 %); < 0 = velocity_gain",
+       "the prior velocity's smoothing gain (0.3 elsewhere) along the weak direction of a degenerate (corridor) "
+       "match, before a match has fixed every direction (then the velocity is held); averages the NDT score's "
+       "ripple over more scans so the estimate does not stall (CSAIL cut to 5.6 m: SLAM error -39 %); < 0 = 0.3",
        kAdvanced},
       {"degenerate_velocity_max_range", "motion prior", FIELD(odometry.degenerate_velocity_max_range), "m",
        atLeast(0),
-       "range gate of the corridor rules (degenerate_velocity_gain, degenerate_hold_time, range_flow_gain): only for "
-       "lasers whose range_max is at most this (URG-04LX 5.6 m gains, full-range CSAIL loses); 0 = any",
-       kAdvanced},
-      {"degenerate_hold_time", "motion prior", FIELD(odometry.degenerate_hold_time), "s", atLeast(0),
-       "for this long after the last match that fixed every direction, a degenerate match leaves the velocity "
-       "along its weak direction as it was (where nothing along a corridor is in range each match pulled a little "
-       "back: the loop building's west corridor lost 0.10-0.36 m); a released prior ends the hold; 0 = off; "
-       ".inf (default) = until a match fixes every direction again",
+       "range gate of the corridor rules (degenerate_velocity_gain, the hold of the velocity along a corridor, "
+       "range_flow_gain): only for lasers whose range_max is at most this (URG-04LX 5.6 m gains, full-range CSAIL "
+       "loses); 0 = any",
        kAdvanced},
       {"range_flow_gain", "motion prior", FIELD(odometry.range_flow_gain), "-", closedInterval(0, 1),
        "in a degenerate match with lines in view that face along the corridor (a niche, a door frame), the speed "
@@ -174,16 +162,10 @@ std::vector<Parameter<S>> motionPriorEntries() {
        kAdvanced},
       {"prior_release_speed", "motion prior", FIELD(odometry.prior_release_speed), "m/s", atLeast(0),
        "below this estimated speed a degenerate match held by the motion prior is polished again without it, and "
-       "that pose taken when it fits clearly better (prior_release_margin, prior_release_sigmas): a robot starting "
+       "that pose taken when it fits clearly better (by 0.005 per point, 3 prior sigmas away): a robot starting "
        "from rest in a corridor is not left behind (loop building start: 0.6-1.2 m lost before, 0.04-0.12 m "
        "with it); 0 = off",
        kAdvanced},
-      {"prior_release_margin", "motion prior", FIELD(odometry.matcher.prior_release_margin), "-", atLeast(0),
-       "the prior-free pose must score this much higher per point (0.004 also fired on scan noise while standing "
-       "still, 0.005 did not in 42 standing tests of 30 s) ...",
-       kAdvanced},
-      {"prior_release_sigmas", "motion prior", FIELD(odometry.matcher.prior_release_sigmas), "-", atLeast(0),
-       "... and lie more than this many prior sigmas away along the corridor", kAdvanced},
   };
 }
 
