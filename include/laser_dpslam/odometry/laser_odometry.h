@@ -5,7 +5,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
-#include <limits>
 #include <random>
 #include <string>
 #include <vector>
