@@ -673,3 +673,44 @@ TEST(DpSlam, HeldSpeedErrorsGrowTheSpreadWithTheTimeHeld) {
   EXPECT_LT(held[80].x(), 0.6 * sampled[80].x());  // no scan-by-scan jitter along the corridor
   EXPECT_NEAR(held[80].y(), sampled[80].y(), 0.5 * sampled[80].y());
 }
+
+// The same blank corridor with a resampling at every update: the weights choose on the particles' positions
+// across the corridor and their headings, which say nothing of their speed errors, so the errors drawn at
+// the hold's start must all still be there at its end (inherited as they were, a few survived by chance and
+// the spread along the corridor stopped growing).
+TEST(DpSlam, ResamplingInAHoldKeepsTheSpeedErrorsDrawn) {
+  const FloorPlan corridor = test::planFromBoxes(40.0, 2.4, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.3, 40.0, 2.4}});
+  DpSlamConfig config;
+  config.resample_threshold = 1.0;
+  config.explore_noise_scale = 1.0;
+  config.map_align_to_walls = false;
+  config.threads = 1;
+  const double dt = 0.1, speed = 0.3, speed_sigma = 0.01;
+  const Eigen::Matrix3d match_cov = Eigen::Vector3d(0.02 * 0.02, 0.002 * 0.002, 0.001 * 0.001).asDiagonal();
+  DpSlam slam(config);
+  ScanSimulator sim(corridor, ScanSimulatorConfig(), 5);
+  std::vector<double> drawn;
+  for (int k = 0; k <= 80; ++k) {
+    const double stamp = 100.0 + k * dt;
+    const PreprocessedScan scan =
+        preprocessScan(sim.simulate(Pose2D(15.0 + speed * k * dt, 1.2, 0.0), stamp), ScanPreprocessorConfig());
+    HeldMotion held;
+    if (k > 0) {
+      held.direction = Eigen::Vector2d(1.0, 0.0);
+      held.speed_sigma = speed_sigma;
+      held.dt = dt;
+    }
+    const DpSlamUpdate u = slam.process(stamp, scan, LaserMount(), Pose2D(k > 0 ? speed * dt : 0.0, 0.0, 0.0),
+                                        match_cov, held);
+    ASSERT_TRUE(k == 0 || u.resampled);
+    if (k == 1) drawn = slam.heldSpeedErrors();
+  }
+  std::vector<double> kept = slam.heldSpeedErrors();
+  std::sort(kept.begin(), kept.end());
+  std::sort(drawn.begin(), drawn.end());
+  EXPECT_EQ(kept, drawn);
+  double sum = 0.0, sq = 0.0;
+  for (double e : kept) sum += e, sq += e * e;
+  const double n = static_cast<double>(kept.size()), sd = std::sqrt(std::max(0.0, sq / n - sum * sum / (n * n)));
+  EXPECT_GT(sd, 0.6 * speed_sigma);
+}

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -52,6 +53,34 @@ TEST(LowVarianceResample, IsUnbiasedOverTheRandomOffset) {
   // A particle with zero weight never survives; a certain one takes everything.
   EXPECT_EQ(counts(lowVarianceResample({0.0, 1.0, 0.0}, 5, 0.999), 3), (std::vector<int>{0, 5, 0}));
   EXPECT_EQ(counts(lowVarianceResample({1.0, 0.0, 0.0}, 5, 0.0), 3), (std::vector<int>{5, 0, 0}));
+}
+
+// Resampling keeps the held speed errors that were drawn: a parent's first child keeps its error, the other
+// children take those of the particles left without one, so the set is unchanged however often the filter
+// resamples on its other coordinates.
+TEST(ParticleFilter, ResamplingKeepsTheSetOfHeldSpeedErrors) {
+  GaussianSampler rng(7);
+  std::vector<double> errors(30);
+  for (double& e : errors) e = 0.01 * rng.normal();
+  const std::vector<double> drawn = errors;
+  for (int round = 0; round < 200; ++round) {
+    std::vector<double> w(errors.size());
+    for (double& x : w) x = std::exp(2.0 * rng.normal());  // weights that know nothing of the errors
+    const std::vector<int> parents = lowVarianceResample(w, w.size(), rng.uniform());
+    const std::vector<double> next = inheritHeldSpeedErrors(parents, errors, rng);
+    for (std::size_t j = 0; j < parents.size(); ++j) {
+      if (j == 0 || parents[j] != parents[j - 1]) EXPECT_EQ(next[j], errors[parents[j]]) << "first child of " << parents[j];
+    }
+    errors = next;
+  }
+  std::vector<double> a = errors, b = drawn;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  EXPECT_EQ(a, b);
+  // Without a resampling (parents = identity) nothing moves.
+  std::vector<int> same(errors.size());
+  for (std::size_t j = 0; j < same.size(); ++j) same[j] = static_cast<int>(j);
+  EXPECT_EQ(inheritHeldSpeedErrors(same, errors, rng), errors);
 }
 
 TEST(NormalizeLogWeights, EffectiveSampleSizeAndRobustness) {

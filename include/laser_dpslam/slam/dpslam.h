@@ -171,6 +171,8 @@ class DpSlam {
   OccupancyGridData bestMap() const;
   std::vector<Pose2D> particlePoses() const;
   std::vector<double> logWeights() const { return logw_; }
+  /// Each particle's held speed error, m/s along the hold's direction (HeldMotion; all 0 outside a hold).
+  const std::vector<double>& heldSpeedErrors() const { return held_speed_error_; }
 
   const DpSlamConfig& config() const { return config_; }
   const DpSlamMap& map() const { return map_; }

@@ -69,6 +69,17 @@ NormalizedWeights normalizeLogWeights(const std::vector<double>& logw);
 /// u0 ∈ [0, 1). Returns, for each new particle, the index of its parent (non-decreasing).
 std::vector<int> lowVarianceResample(const std::vector<double>& w, std::size_t n, double u0);
 
+/// The held speed errors (HeldMotion) after a resampling: particle j of the new generation descends from
+/// parents[j]; a parent's first child keeps its error, its other children take, in random order, the errors
+/// of the particles left without a child. The set of errors is the one drawn at the hold's start. Where no
+/// scan can place the particles along a corridor, resampling selects on their other coordinates, and
+/// inheriting the errors as they are let a few of them survive by chance (every one but one within some
+/// 6 s of resampling on a generated building): the spread that should grow with the time held stopped
+/// growing, and the lineage left kept its error to the stretch's end (doc/experiments.md, "Held speed
+/// errors lost to resampling").
+std::vector<double> inheritHeldSpeedErrors(const std::vector<int>& parents, const std::vector<double>& errors,
+                                           GaussianSampler& rng);
+
 /// Weighted mean pose (angle: circular mean) and covariance of (x, y, θ) around it.
 Eigen::Matrix3d weightedPoseCovariance(const std::vector<Pose2D>& poses, const std::vector<double>& w,
                                        Pose2D* mean = nullptr);

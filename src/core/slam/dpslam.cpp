@@ -471,13 +471,11 @@ void DpSlam::adoptSurvivors(const std::vector<int>& parents, const std::vector<P
   std::vector<double> new_logw(P);
   const double max_logw = logw_[best_parent];
   best_ = 0;
-  std::vector<double> new_error(P);
   for (int j = 0; j < P; ++j) {
     poses_[j] = chosen[parents[j]];
     new_logw[j] = resampled ? 0.0 : logw_[parents[j]] - max_logw;
-    new_error[j] = held_speed_error_[parents[j]];
   }
-  held_speed_error_.swap(new_error);
+  if (resampled && holding_) held_speed_error_ = inheritHeldSpeedErrors(parents, held_speed_error_, rng_);
   for (int j = 0; j < P; ++j) {
     if (parents[j] == best_parent) {
       best_ = j;

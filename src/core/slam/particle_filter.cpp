@@ -116,6 +116,29 @@ std::vector<int> lowVarianceResample(const std::vector<double>& w, std::size_t n
   return parents;
 }
 
+std::vector<double> inheritHeldSpeedErrors(const std::vector<int>& parents, const std::vector<double>& errors,
+                                           GaussianSampler& rng) {
+  std::vector<int> children(errors.size(), 0);
+  for (int p : parents) ++children[static_cast<std::size_t>(p)];
+  std::vector<double> orphaned;
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    if (children[i] == 0) orphaned.push_back(errors[i]);
+  }
+  for (std::size_t k = orphaned.size(); k > 1; --k) {  // Fisher-Yates
+    std::swap(orphaned[k - 1], orphaned[std::min(k - 1, static_cast<std::size_t>(rng.uniform() * k))]);
+  }
+  std::vector<double> out(parents.size());
+  std::vector<bool> first(errors.size(), true);
+  std::size_t next = 0;
+  for (std::size_t j = 0; j < parents.size(); ++j) {
+    const std::size_t p = static_cast<std::size_t>(parents[j]);
+    const bool keep = first[p] || next >= orphaned.size();
+    out[j] = keep ? errors[p] : orphaned[next++];
+    first[p] = false;
+  }
+  return out;
+}
+
 Eigen::Matrix3d weightedPoseCovariance(const std::vector<Pose2D>& poses, const std::vector<double>& w, Pose2D* mean) {
   double sw = 0.0, mx = 0.0, my = 0.0, sc = 0.0, ss = 0.0;
   for (std::size_t i = 0; i < poses.size(); ++i) {
