@@ -69,7 +69,9 @@ TEST(ParticleFilter, ResamplingKeepsTheSetOfHeldSpeedErrors) {
     const std::vector<int> parents = lowVarianceResample(w, w.size(), rng.uniform());
     const std::vector<double> next = inheritHeldSpeedErrors(parents, errors, rng);
     for (std::size_t j = 0; j < parents.size(); ++j) {
-      if (j == 0 || parents[j] != parents[j - 1]) EXPECT_EQ(next[j], errors[parents[j]]) << "first child of " << parents[j];
+      if (j == 0 || parents[j] != parents[j - 1]) {
+        EXPECT_EQ(next[j], errors[parents[j]]) << "first child of " << parents[j];
+      }
     }
     errors = next;
   }
