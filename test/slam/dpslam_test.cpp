@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <set>
 #include <string>
 
@@ -622,6 +623,30 @@ TEST(DpSlam, EitherTravelThresholdAloneWorks) {
   EXPECT_TRUE(travelThresholdReached(Pose2D(0.0, 0.0, 0.35), 0.2, 0.3));
 }
 
+namespace {
+// Drives `slam` 8 s down a blank corridor (two walls, nothing facing along it) at 0.3 m/s, 10 Hz; with
+// `speed_sigma` > 0 every scan after the first is a held motion with that speed σ. `each` sees every update.
+void driveBlankCorridor(DpSlam& slam, double speed_sigma,
+                        const std::function<void(int k, const DpSlamUpdate& u)>& each) {
+  const FloorPlan corridor = test::planFromBoxes(40.0, 2.4, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.3, 40.0, 2.4}});
+  const double dt = 0.1, speed = 0.3;
+  const Eigen::Matrix3d match_cov = Eigen::Vector3d(0.02 * 0.02, 0.002 * 0.002, 0.001 * 0.001).asDiagonal();
+  ScanSimulator sim(corridor, ScanSimulatorConfig(), 5);
+  for (int k = 0; k <= 80; ++k) {
+    const double stamp = 100.0 + k * dt;
+    const PreprocessedScan scan =
+        preprocessScan(sim.simulate(Pose2D(15.0 + speed * k * dt, 1.2, 0.0), stamp), ScanPreprocessorConfig());
+    HeldMotion held;
+    if (speed_sigma > 0.0 && k > 0) {
+      held.direction = Eigen::Vector2d(1.0, 0.0);
+      held.speed_sigma = speed_sigma;
+      held.dt = dt;
+    }
+    each(k, slam.process(stamp, scan, LaserMount(), Pose2D(k > 0 ? speed * dt : 0.0, 0.0, 0.0), match_cov, held));
+  }
+}
+}  // namespace
+
 // HeldMotion: along a blank corridor (two walls, nothing facing along it within the laser's range) the
 // odometry's motion is a held speed, whose error is the same at every scan. Each particle keeps one speed
 // error through the hold, so the particles' spread along the corridor grows with the time held (a
@@ -629,7 +654,6 @@ TEST(DpSlam, EitherTravelThresholdAloneWorks) {
 // growing with the root of the time. Across the corridor nothing changes. No resampling, one candidate per
 // particle and a negligible per-scan floor, so that the positions show the proposal alone.
 TEST(DpSlam, HeldSpeedErrorsGrowTheSpreadWithTheTimeHeld) {
-  const FloorPlan corridor = test::planFromBoxes(40.0, 2.4, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.3, 40.0, 2.4}});
   DpSlamConfig config;
   config.resample_threshold = 0.0;
   config.oversampling = 1;
@@ -638,30 +662,18 @@ TEST(DpSlam, HeldSpeedErrorsGrowTheSpreadWithTheTimeHeld) {
   config.proposal.min_sigma_theta = 0.0005;
   config.map_align_to_walls = false;
   config.threads = 1;
-  const double dt = 0.1, speed = 0.3, speed_sigma = 0.01;
-  Eigen::Matrix3d match_cov = Eigen::Vector3d(0.02 * 0.02, 0.002 * 0.002, 0.001 * 0.001).asDiagonal();
+  const double speed_sigma = 0.01;
   // Spread (standard deviation over the particles) along and across the corridor after each scan.
   auto spreads = [&](bool held_speed) {
     DpSlam slam(config);
-    ScanSimulator sim(corridor, ScanSimulatorConfig(), 5);
     std::vector<Eigen::Vector2d> out;
-    for (int k = 0; k <= 80; ++k) {
-      const double stamp = 100.0 + k * dt;
-      const PreprocessedScan scan = preprocessScan(sim.simulate(Pose2D(15.0 + speed * k * dt, 1.2, 0.0), stamp),
-                                                   ScanPreprocessorConfig());
-      HeldMotion held;
-      if (held_speed && k > 0) {
-        held.direction = Eigen::Vector2d(1.0, 0.0);
-        held.speed_sigma = speed_sigma;
-        held.dt = dt;
-      }
-      slam.process(stamp, scan, LaserMount(), Pose2D(k > 0 ? speed * dt : 0.0, 0.0, 0.0), match_cov, held);
+    driveBlankCorridor(slam, held_speed ? speed_sigma : 0.0, [&](int, const DpSlamUpdate&) {
       const std::vector<Pose2D> poses = slam.particlePoses();
       Eigen::Vector2d mean = Eigen::Vector2d::Zero(), var = Eigen::Vector2d::Zero();
       for (const Pose2D& p : poses) mean += Eigen::Vector2d(p.x, p.y) / poses.size();
       for (const Pose2D& p : poses) var += (Eigen::Vector2d(p.x, p.y) - mean).cwiseAbs2() / poses.size();
       out.push_back(var.cwiseSqrt());
-    }
+    });
     return out;
   };
   const std::vector<Eigen::Vector2d> held = spreads(true), sampled = spreads(false);
@@ -679,32 +691,20 @@ TEST(DpSlam, HeldSpeedErrorsGrowTheSpreadWithTheTimeHeld) {
 // the hold's start must all still be there at its end (inherited as they were, a few survived by chance and
 // the spread along the corridor stopped growing).
 TEST(DpSlam, ResamplingInAHoldKeepsTheSpeedErrorsDrawn) {
-  const FloorPlan corridor = test::planFromBoxes(40.0, 2.4, 0.02, {{0.0, 0.0, 40.0, 0.1}, {0.0, 2.3, 40.0, 2.4}});
   DpSlamConfig config;
   config.resample_threshold = 1.0;
   config.explore_noise_scale = 1.0;
   config.map_align_to_walls = false;
   config.threads = 1;
-  const double dt = 0.1, speed = 0.3, speed_sigma = 0.01;
-  const Eigen::Matrix3d match_cov = Eigen::Vector3d(0.02 * 0.02, 0.002 * 0.002, 0.001 * 0.001).asDiagonal();
+  const double speed_sigma = 0.01;
   DpSlam slam(config);
-  ScanSimulator sim(corridor, ScanSimulatorConfig(), 5);
   std::vector<double> drawn;
-  for (int k = 0; k <= 80; ++k) {
-    const double stamp = 100.0 + k * dt;
-    const PreprocessedScan scan =
-        preprocessScan(sim.simulate(Pose2D(15.0 + speed * k * dt, 1.2, 0.0), stamp), ScanPreprocessorConfig());
-    HeldMotion held;
-    if (k > 0) {
-      held.direction = Eigen::Vector2d(1.0, 0.0);
-      held.speed_sigma = speed_sigma;
-      held.dt = dt;
-    }
-    const DpSlamUpdate u = slam.process(stamp, scan, LaserMount(), Pose2D(k > 0 ? speed * dt : 0.0, 0.0, 0.0),
-                                        match_cov, held);
-    ASSERT_TRUE(k == 0 || u.resampled);
+  int resampled = 0;
+  driveBlankCorridor(slam, speed_sigma, [&](int k, const DpSlamUpdate& u) {
+    resampled += u.resampled ? 1 : 0;
     if (k == 1) drawn = slam.heldSpeedErrors();
-  }
+  });
+  ASSERT_EQ(resampled, 80);  // every update after the first
   std::vector<double> kept = slam.heldSpeedErrors();
   std::sort(kept.begin(), kept.end());
   std::sort(drawn.begin(), drawn.end());
