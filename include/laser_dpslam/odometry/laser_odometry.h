@@ -12,6 +12,7 @@
 #include "laser_dpslam/common/laser_mount.h"
 #include "laser_dpslam/common/pose2d.h"
 #include "laser_dpslam/matching/scan_matcher.h"
+#include "laser_dpslam/odometry/held_speed.h"
 #include "laser_dpslam/odometry/range_flow.h"
 #include "laser_dpslam/scan/saliency_resampler.h"
 #include "laser_dpslam/scan/scan_preprocessor.h"
@@ -176,7 +177,7 @@ class LaserOdometry {
   /// Cuts a degenerate match's step along its weak direction to kDegenerateStepSigmas · prior_sigma from the prior.
   static void limitDegenerateStep(const Pose2D& prior, double prior_sigma, MatchResult& m);
   /// Keeps the poses of constrained matches on the straight run; at a blank stretch's first scan, the held speed.
-  void seeAlongCorridor(double stamp, const OdometryUpdate& u);
+  void seeAlongCorridor(double stamp, double dt, const OdometryUpdate& u);
   void holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d& weak);
   /// The scan's match against the local map from `prior`, into u.match (and u.points_used).
   void matchToLocalMap(const PreprocessedScan& scan, const LaserMount& mount,
@@ -230,8 +231,6 @@ class LaserOdometry {
   // The window's two halves agree within this fraction of the speed plus kHoldSpeedAgreementMin (m/s).
   static constexpr double kHoldSpeedAgreement = 0.03;
   static constexpr double kHoldSpeedAgreementMin = 0.005;
-  // rad: a pose turned more than this from the newest ends the straight run the held speed is fitted over.
-  static constexpr double kStraightRunHeading = 0.05;
   static constexpr double kNoStamp = -1e300;  ///< held_since_ / fitted_through_: none
   /// A match neither degenerate nor weak has measured the velocity since the start, a gap or a released
   /// prior: degenerate matches hold it along their weak direction (velocityAlongCorridor).
@@ -244,6 +243,7 @@ class LaserOdometry {
   Eigen::Vector2d last_weak_ = Eigen::Vector2d::Zero();  ///< the last match's weak direction if it was degenerate (matching frame), else 0
   std::deque<std::pair<double, Pose2D>> seen_along_;  ///< stamped poses of constrained matches on the current straight run
   double fitted_through_ = kNoStamp;  ///< stamp of the newest pose the last held speed was fitted to
+  HeldSpeed held_speed_;  ///< the held speed of the current straight run, fit by fit
   bool was_blank_ = false;  ///< the last scan was in a blank stretch (velocity_held_blank)
   double keyframe_matched_ = -1.0;  ///< matched fraction of the first match after the last keyframe (-1: none yet)
   std::uint64_t scan_count_ = 0;

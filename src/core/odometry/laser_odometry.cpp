@@ -40,6 +40,7 @@ void LaserOdometry::reset() {
   seen_along_.clear();
   was_blank_ = false;
   fitted_through_ = kNoStamp;
+  held_speed_.reset();
 }
 
 void LaserOdometry::addKeyframe(const std::vector<Eigen::Vector2d>& base_points, const PreprocessedScan& scan,
@@ -209,13 +210,14 @@ OdometryUpdate LaserOdometry::processInFrame(const PreprocessedScan& scan, const
   matchCovariances(previous, u);
   if (dt > 0.0 && dt <= config_.max_prior_gap) {
     updateVelocity(scan, mount, previous, dt, u);
-    seeAlongCorridor(scan.stamp, u);
+    seeAlongCorridor(scan.stamp, dt, u);
     heldCovariance(previous, scan.stamp, dt, u);
   } else {
     held_since_ = kNoStamp;
     last_flow_ = RangeFlow();
     velocity_.setZero();
     velocity_measured_ = false;  // nothing measured to hold
+    held_speed_.reset();
   }
   if (!u.match.degenerate && !u.match.weak) velocity_measured_ = true;
   last_stamp_ = scan.stamp;
@@ -440,7 +442,7 @@ void LaserOdometry::limitDegenerateStep(const Pose2D& prior, double prior_sigma,
   }
 }
 
-void LaserOdometry::seeAlongCorridor(double stamp, const OdometryUpdate& u) {
+void LaserOdometry::seeAlongCorridor(double stamp, double dt, const OdometryUpdate& u) {
   // seen_along_ spans kHoldSpeedWindow s back from its newest pose, not from now: degenerate matches between
   // it and a blank stretch (a corridor's last metres before it turns blank) do not age it out.
   const double newest =
@@ -458,10 +460,11 @@ void LaserOdometry::seeAlongCorridor(double stamp, const OdometryUpdate& u) {
   // run whose speed is fitted.
   if (!u.match.degenerate && !u.match.weak && !u.velocity_held_blank) {
     while (!seen_along_.empty() &&
-           std::abs(normalizeAngle(seen_along_.front().second.theta - pose_.theta)) > kStraightRunHeading) {
+           std::abs(normalizeAngle(seen_along_.front().second.theta - pose_.theta)) > HeldSpeed::kStraightRunHeading) {
       seen_along_.pop_front();
     }
     seen_along_.push_back({stamp, pose_});
+    held_speed_.observe(pose_.theta, dt);
   }
   was_blank_ = u.velocity_held_blank;
 }
@@ -470,27 +473,32 @@ void LaserOdometry::holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d
   // A blank stretch starts: the speed it keeps along the corridor is a line fitted to the positions of the
   // constrained matches of the straight run before it (up to kHoldSpeedWindow s), rather than the last few
   // scans' smoothed velocity (a few per cent off, which a 40 m corridor turns into metres). The window
-  // halves until its two halves agree (no acceleration inside it); with no such window the smoothed
-  // velocity stays.
+  // halves until its two halves agree (no acceleration inside it). The fit updates the run's held speed
+  // by its variance (HeldSpeed): a few constrained matches inside a long blank stretch barely move it.
   const Eigen::Matrix2d frame = pose_.rotation();
   const Eigen::Vector2d w = frame.transpose() * weak;  // base frame
   const double end = seen_along_.empty() ? stamp : seen_along_.back().first;
-  auto speed = [&](double from, double to) {
+  auto speed = [&](double from, double to, double* dt) {
     const Pose2D* a;
     const Pose2D* b;
-    double dt;
-    if (!spanOf(seen_along_, from, to, &a, &b, &dt)) return std::numeric_limits<double>::quiet_NaN();
-    return w.dot(frame.transpose() * Eigen::Vector2d(b->x - a->x, b->y - a->y)) / dt;
+    if (!spanOf(seen_along_, from, to, &a, &b, dt)) return std::numeric_limits<double>::quiet_NaN();
+    return w.dot(frame.transpose() * Eigen::Vector2d(b->x - a->x, b->y - a->y)) / *dt;
   };
   for (double span = kHoldSpeedWindow; span >= kMinHoldSpeedWindow; span *= 0.5) {
-    const double all = speed(end - span, end), first = speed(end - span, end - 0.5 * span),
-                 second = speed(end - 0.5 * span, end);
+    double covered, half;
+    const double all = speed(end - span, end, &covered), first = speed(end - span, end - 0.5 * span, &half),
+                 second = speed(end - 0.5 * span, end, &half);
     if (!std::isfinite(all) || !std::isfinite(first) || !std::isfinite(second)) continue;
     if (std::abs(first - second) > kHoldSpeedAgreement * std::abs(all) + kHoldSpeedAgreementMin) continue;
     const double v = speedFit(seen_along_, end - span, end, frame, w, all);
-    velocity_.head<2>() += w * (v - w.dot(velocity_.head<2>()));
+    const double held = held_speed_.fuse(v, HeldSpeed::fitVariance(covered), pose_.theta, weak);
+    velocity_.head<2>() += w * (held - w.dot(velocity_.head<2>()));
     return;
   }
+  // No window without acceleration: the smoothed velocity, no better known than a fit over the shortest one.
+  const double held = held_speed_.fuse(w.dot(velocity_.head<2>()), HeldSpeed::fitVariance(kMinHoldSpeedWindow),
+                                      pose_.theta, weak);
+  velocity_.head<2>() += w * (held - w.dot(velocity_.head<2>()));
 }
 
 bool LaserOdometry::keyframeDue(const MatchResult& match) {
