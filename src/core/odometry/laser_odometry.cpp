@@ -485,7 +485,7 @@ void LaserOdometry::holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d
     return w.dot(frame.transpose() * Eigen::Vector2d(b->x - a->x, b->y - a->y)) / *dt;
   };
   for (double span = kHoldSpeedWindow; span >= kMinHoldSpeedWindow; span *= 0.5) {
-    double covered, half;
+    double covered = 0.0, half = 0.0;
     const double all = speed(end - span, end, &covered), first = speed(end - span, end - 0.5 * span, &half),
                  second = speed(end - 0.5 * span, end, &half);
     if (!std::isfinite(all) || !std::isfinite(first) || !std::isfinite(second)) continue;
