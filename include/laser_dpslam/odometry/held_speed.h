@@ -23,6 +23,8 @@ class HeldSpeed {
   // rad: a heading this far from the one of the last fit is another straight run (as the fit's own window).
   static constexpr double kStraightRunHeading = 0.05;
 
+  /// Headings `a` and `b` (rad) lie on one straight run: within kStraightRunHeading of each other.
+  static bool sameRun(double a, double b);
   /// The variance of a speed fitted over `span` s of constrained matches.
   static double fitVariance(double span) { return 2.0 * (kFitPositionSigma / span) * (kFitPositionSigma / span); }
 

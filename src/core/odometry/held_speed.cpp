@@ -6,8 +6,10 @@
 
 namespace laser_dpslam {
 
+bool HeldSpeed::sameRun(double a, double b) { return std::abs(normalizeAngle(a - b)) <= kStraightRunHeading; }
+
 void HeldSpeed::observe(double heading, double dt) {
-  if (std::abs(normalizeAngle(heading - heading_)) > kStraightRunHeading) {
+  if (!sameRun(heading, heading_)) {
     reset();
     return;
   }
@@ -16,8 +18,7 @@ void HeldSpeed::observe(double heading, double dt) {
 
 double HeldSpeed::fuse(double v, double variance, double heading, const Eigen::Vector2d& direction) {
   const double last = direction_.dot(direction) < 0.0 ? -speed_ : speed_;
-  const bool same_run = std::abs(normalizeAngle(heading - heading_)) <= kStraightRunHeading;
-  if (same_run && valid() && std::abs(v - last) <= kGate * std::sqrt(variance_ + variance)) {
+  if (sameRun(heading, heading_) && valid() && std::abs(v - last) <= kGate * std::sqrt(variance_ + variance)) {
     const double k = variance_ / (variance_ + variance);
     v = last + k * (v - last);
     variance = (1.0 - k) * variance_;

@@ -460,7 +460,7 @@ void LaserOdometry::seeAlongCorridor(double stamp, double dt, const OdometryUpda
   // run whose speed is fitted.
   if (!u.match.degenerate && !u.match.weak && !u.velocity_held_blank) {
     while (!seen_along_.empty() &&
-           std::abs(normalizeAngle(seen_along_.front().second.theta - pose_.theta)) > HeldSpeed::kStraightRunHeading) {
+           !HeldSpeed::sameRun(seen_along_.front().second.theta, pose_.theta)) {
       seen_along_.pop_front();
     }
     seen_along_.push_back({stamp, pose_});
@@ -484,20 +484,19 @@ void LaserOdometry::holdSpeedFromSeenMatches(double stamp, const Eigen::Vector2d
     if (!spanOf(seen_along_, from, to, &a, &b, dt)) return std::numeric_limits<double>::quiet_NaN();
     return w.dot(frame.transpose() * Eigen::Vector2d(b->x - a->x, b->y - a->y)) / *dt;
   };
+  // With no window free of acceleration: the smoothed velocity, no better known than a fit over the shortest one.
+  double v = w.dot(velocity_.head<2>()), variance = HeldSpeed::fitVariance(kMinHoldSpeedWindow);
   for (double span = kHoldSpeedWindow; span >= kMinHoldSpeedWindow; span *= 0.5) {
     double covered = 0.0, half = 0.0;
     const double all = speed(end - span, end, &covered), first = speed(end - span, end - 0.5 * span, &half),
                  second = speed(end - 0.5 * span, end, &half);
     if (!std::isfinite(all) || !std::isfinite(first) || !std::isfinite(second)) continue;
     if (std::abs(first - second) > kHoldSpeedAgreement * std::abs(all) + kHoldSpeedAgreementMin) continue;
-    const double v = speedFit(seen_along_, end - span, end, frame, w, all);
-    const double held = held_speed_.fuse(v, HeldSpeed::fitVariance(covered), pose_.theta, weak);
-    velocity_.head<2>() += w * (held - w.dot(velocity_.head<2>()));
-    return;
+    v = speedFit(seen_along_, end - span, end, frame, w, all);
+    variance = HeldSpeed::fitVariance(covered);
+    break;
   }
-  // No window without acceleration: the smoothed velocity, no better known than a fit over the shortest one.
-  const double held = held_speed_.fuse(w.dot(velocity_.head<2>()), HeldSpeed::fitVariance(kMinHoldSpeedWindow),
-                                      pose_.theta, weak);
+  const double held = held_speed_.fuse(v, variance, pose_.theta, weak);
   velocity_.head<2>() += w * (held - w.dot(velocity_.head<2>()));
 }
 
